@@ -1,0 +1,1 @@
+//! Minimal-coordinates multibody systems (thesis Section 3.3.3-3.3.4).

@@ -1,0 +1,67 @@
+//! Jacobian blocks of a residual system and their finite-difference estimate.
+
+use nalgebra::DMatrix;
+
+use super::System;
+
+/// The blocks M = ∂f/∂q'', CT = ∂f/∂q' and KT = ∂f/∂q (Eq. 3.12, 3.17).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Jacobian {
+    pub m: DMatrix<f64>,
+    pub ct: DMatrix<f64>,
+    pub kt: DMatrix<f64>,
+}
+
+impl Jacobian {
+    pub fn zeros(n: usize) -> Self {
+        Jacobian { m: DMatrix::zeros(n, n), ct: DMatrix::zeros(n, n), kt: DMatrix::zeros(n, n) }
+    }
+    pub fn fill_zero(&mut self) {
+        self.m.fill(0.0);
+        self.ct.fill(0.0);
+        self.kt.fill(0.0);
+    }
+    /// The Newmark iteration matrix J = M + γh CT + βh² KT (Eq. 3.14).
+    pub fn iteration_matrix(&self, beta: f64, gamma: f64, h: f64) -> DMatrix<f64> {
+        &self.m + &self.ct * (gamma * h) + &self.kt * (beta * h * h)
+    }
+    /// Exact blocks when the system provides them, finite differences otherwise.
+    pub fn evaluate<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Self {
+        let mut jac = Jacobian::zeros(q.len());
+        if !sys.jacobian(t, q, qd, qdd, &mut jac) {
+            jac = finite_difference_jacobian(sys, t, q, qd, qdd);
+        }
+        jac
+    }
+}
+
+/// Column-by-column central finite-difference estimate of M, CT and KT (the EasyDyn method of
+/// Section 3.3.2). It is the fallback for systems without analytic blocks and the oracle the
+/// analytic blocks are tested against.
+pub fn finite_difference_jacobian<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Jacobian {
+    let n = q.len();
+    let scales = sys.layout().scales.clone();
+    let mut jac = Jacobian::zeros(n);
+    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+    let mut x = [q.to_vec(), qd.to_vec(), qdd.to_vec()];
+    for block in 0..3 {
+        for j in 0..n {
+            let x0 = x[block][j];
+            let step = 1e-6 * x0.abs().max(scales.get(j).copied().unwrap_or(1.0)).max(1e-12);
+            x[block][j] = x0 + step;
+            sys.residual(t, &x[0], &x[1], &x[2], &mut fp);
+            x[block][j] = x0 - step;
+            sys.residual(t, &x[0], &x[1], &x[2], &mut fm);
+            x[block][j] = x0;
+            let target = match block {
+                0 => &mut jac.kt,
+                1 => &mut jac.ct,
+                _ => &mut jac.m,
+            };
+            for i in 0..n {
+                target[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+            }
+        }
+    }
+    jac
+}

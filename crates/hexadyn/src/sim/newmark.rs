@@ -1,0 +1,368 @@
+//! Implicit Newmark integration with Newton-Raphson on q''(t+h) (thesis Eq. 3.7-3.15).
+
+use nalgebra::{DMatrix, DVector, LU};
+
+use super::error::largest_rows;
+use super::{Jacobian, Order, SimError, System};
+
+/// Integration parameters. Defaults: the trapezoidal rule β = 1/4, γ = 1/2 (unconditionally
+/// stable for linear systems, second order, no numerical damping).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewmarkOptions {
+    /// Newmark β (Eq. 3.7).
+    pub beta: f64,
+    /// Newmark γ (Eq. 3.8); γ > 1/2 adds numerical damping (then take β ≥ (γ + 1/2)²/4).
+    pub gamma: f64,
+    /// Tolerance on the error estimate of Eq. 3.15, in units of the layout scales.
+    pub tolerance: f64,
+    /// First step tried.
+    pub h_initial: f64,
+    pub h_min: f64,
+    pub h_max: f64,
+    /// Newton stops when the scaled correction of the integrated quantities is below
+    /// `newton_tolerance` × `tolerance`.
+    pub newton_tolerance: f64,
+    /// Newton iterations allowed per step before the Jacobian is refreshed or the step reduced.
+    pub max_iterations: usize,
+    /// A contraction ratio of the Newton corrections above this makes the iteration "slow":
+    /// the factorization is refreshed (modified Newton, Section 3.3.2).
+    pub slow_contraction: f64,
+    /// Adapt h from the error estimate (Eq. 3.15); with `false` the step is h_max, shortened
+    /// only to land on requested instants or after a Newton failure.
+    pub adaptive: bool,
+}
+
+impl Default for NewmarkOptions {
+    fn default() -> Self {
+        NewmarkOptions {
+            beta: 0.25,
+            gamma: 0.5,
+            tolerance: 1e-6,
+            h_initial: 1e-4,
+            h_min: 1e-10,
+            h_max: 1e-2,
+            newton_tolerance: 1e-2,
+            max_iterations: 8,
+            slow_contraction: 0.5,
+            adaptive: true,
+        }
+    }
+}
+
+impl NewmarkOptions {
+    fn validate(&self) -> Result<(), SimError> {
+        let check = |ok: bool, field, value, allowed| if ok { Ok(()) } else { Err(SimError::InvalidOption { field, value, allowed }) };
+        check(self.gamma >= 0.5 && self.gamma.is_finite(), "gamma", self.gamma, "gamma >= 0.5 (stability)")?;
+        check(self.beta >= self.gamma / 2.0 - 1e-15 && self.beta <= 1.0, "beta", self.beta, "gamma/2 <= beta <= 1 (unconditional stability)")?;
+        check(self.tolerance > 0.0, "tolerance", self.tolerance, "> 0")?;
+        check(self.h_min > 0.0 && self.h_min <= self.h_max, "h_min", self.h_min, "0 < h_min <= h_max")?;
+        check(self.h_initial > 0.0, "h_initial", self.h_initial, "> 0")?;
+        check(self.newton_tolerance > 0.0, "newton_tolerance", self.newton_tolerance, "> 0")?;
+        check(self.max_iterations >= 1, "max_iterations", self.max_iterations as f64, ">= 1")?;
+        check(self.slow_contraction > 0.0 && self.slow_contraction < 1.0, "slow_contraction", self.slow_contraction, "in (0, 1)")
+    }
+}
+
+/// State (t, q, q', q'') of a residual system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub t: f64,
+    pub q: DVector<f64>,
+    pub qd: DVector<f64>,
+    pub qdd: DVector<f64>,
+}
+
+/// Work counters, for benchmarks and diagnostics.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct NewmarkStats {
+    pub steps: usize,
+    pub rejected_steps: usize,
+    pub newton_iterations: usize,
+    pub residual_evaluations: usize,
+    pub jacobian_evaluations: usize,
+    pub factorizations: usize,
+}
+
+/// The Newmark integrator. It owns the state and the (reused) factorized iteration matrix.
+pub struct Newmark {
+    pub options: NewmarkOptions,
+    state: State,
+    /// Step proposed for the next interval.
+    h: f64,
+    jacobian: Option<Jacobian>,
+    /// Factorization of J (Eq. 3.14) and the h it was built with.
+    lu: Option<(LU<f64, nalgebra::Dyn, nalgebra::Dyn>, f64)>,
+    /// True when `jacobian` was evaluated during the current step (refreshing it again is useless).
+    jacobian_fresh: bool,
+    stats: NewmarkStats,
+    work: Work,
+}
+
+struct Work {
+    f: Vec<f64>,
+    q: DVector<f64>,
+    qd: DVector<f64>,
+    qdd: DVector<f64>,
+    weight_q: DVector<f64>,
+}
+
+enum StepOutcome {
+    Accepted,
+    Rejected { h_next: f64 },
+}
+
+impl Newmark {
+    /// Starts at (t0, q0, q'0) with the consistent q''0 solved from f = 0 (see [`Self::reset_accelerations`]).
+    pub fn new<S: System + ?Sized>(sys: &mut S, t0: f64, q0: &[f64], qd0: &[f64], options: NewmarkOptions) -> Result<Self, SimError> {
+        options.validate()?;
+        let n = sys.layout().len();
+        assert_eq!(q0.len(), n, "q0 has {} entries, the system {}", q0.len(), n);
+        assert_eq!(qd0.len(), n, "qd0 has {} entries, the system {}", qd0.len(), n);
+        let h = options.h_initial.clamp(options.h_min, options.h_max);
+        let mut nm = Newmark {
+            options,
+            state: State { t: t0, q: DVector::from_column_slice(q0), qd: DVector::from_column_slice(qd0), qdd: DVector::zeros(n) },
+            h,
+            jacobian: None,
+            lu: None,
+            jacobian_fresh: false,
+            stats: NewmarkStats::default(),
+            work: Work { f: vec![0.0; n], q: DVector::zeros(n), qd: DVector::zeros(n), qdd: DVector::zeros(n), weight_q: DVector::zeros(n) },
+        };
+        nm.reset_accelerations(sys)?;
+        Ok(nm)
+    }
+
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+    pub fn stats(&self) -> &NewmarkStats {
+        &self.stats
+    }
+    /// The step the integrator will try next.
+    pub fn step_size(&self) -> f64 {
+        self.h
+    }
+
+    /// Replaces the state, e.g. after an impulsive change; accelerations are made consistent.
+    pub fn set_state<S: System + ?Sized>(&mut self, sys: &mut S, q: &[f64], qd: &[f64]) -> Result<(), SimError> {
+        self.state.q.copy_from_slice(q);
+        self.state.qd.copy_from_slice(qd);
+        self.reset_accelerations(sys)
+    }
+
+    /// Solves f(q, q', q'', t) = 0 for q'' at the current (t, q, q'), e.g. after the inputs
+    /// jumped (zero-order hold at a control instant), so that the error estimate of the next step
+    /// does not see the discontinuity. Uses Newton on M = ∂f/∂q''; when M is singular (algebraic
+    /// rows) q'' is left as it is and the next Newmark step restores consistency.
+    pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
+        let t = self.state.t;
+        for _ in 0..self.options.max_iterations {
+            sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
+            self.stats.residual_evaluations += 1;
+            check_finite(sys, t, &self.work.f)?;
+            let jac = Jacobian::evaluate(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
+            self.stats.jacobian_evaluations += 1;
+            let Some(dx) = LU::new(jac.m.clone()).solve(&DVector::from_column_slice(&self.work.f)) else {
+                return Ok(());
+            };
+            self.state.qdd -= &dx;
+            let scale = dx.iter().zip(self.state.qdd.iter()).map(|(d, a)| d.abs() / (1.0 + a.abs())).fold(0.0, f64::max);
+            if scale < 1e-10 {
+                break;
+            }
+        }
+        Ok(())
+    }
+
+    /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15). Inputs are held constant.
+    pub fn advance_to<S: System + ?Sized>(&mut self, sys: &mut S, t_end: f64) -> Result<(), SimError> {
+        if t_end < self.state.t {
+            return Err(SimError::Backwards { requested: t_end, current: self.state.t });
+        }
+        let eps = 1e-12 * t_end.abs().max(1.0);
+        while t_end - self.state.t > eps {
+            let remaining = t_end - self.state.t;
+            let mut h = self.h.min(self.options.h_max);
+            let lands = h >= remaining * (1.0 - 1e-9);
+            if lands {
+                h = remaining;
+            } else if h > 0.5 * remaining {
+                // Two balanced steps rather than a long one and a sliver.
+                h = 0.5 * remaining;
+            }
+            match self.step(sys, h)? {
+                StepOutcome::Accepted => {
+                    if lands {
+                        self.state.t = t_end;
+                    }
+                }
+                StepOutcome::Rejected { h_next } => {
+                    if h_next < self.options.h_min {
+                        let rows = self.fastest_rows(sys);
+                        return Err(SimError::StepTooSmall { t: self.state.t, h, error: f64::NAN, rows });
+                    }
+                    self.h = h_next;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn weights<S: System + ?Sized>(&mut self, sys: &S) {
+        let layout = sys.layout();
+        for i in 0..self.work.weight_q.len() {
+            self.work.weight_q[i] = 1.0 / layout.scales[i];
+        }
+    }
+
+    fn refresh_jacobian<S: System + ?Sized>(&mut self, sys: &mut S, t: f64) {
+        self.jacobian = Some(Jacobian::evaluate(sys, t, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice()));
+        self.stats.jacobian_evaluations += 1;
+        self.jacobian_fresh = true;
+        self.lu = None;
+    }
+
+    fn factorize<S: System + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<(), SimError> {
+        if self.jacobian.is_none() {
+            self.refresh_jacobian(sys, self.state.t + h);
+        }
+        let jac = self.jacobian.as_ref().expect("jacobian present");
+        let matrix: DMatrix<f64> = jac.iteration_matrix(self.options.beta, self.options.gamma, h);
+        let lu = LU::new(matrix);
+        self.stats.factorizations += 1;
+        if !lu.is_invertible() {
+            return Err(SimError::Singular { what: "Newmark iteration", t: self.state.t });
+        }
+        self.lu = Some((lu, h));
+        Ok(())
+    }
+
+    /// Newmark predictor-corrector for q(t+h), q'(t+h) from q''(t+h) (Eq. 3.7-3.8).
+    fn update_kinematics(&mut self, h: f64) {
+        let (b, g) = (self.options.beta, self.options.gamma);
+        let s = &self.state;
+        let w = &mut self.work;
+        for i in 0..s.q.len() {
+            w.q[i] = s.q[i] + h * s.qd[i] + (0.5 - b) * h * h * s.qdd[i] + b * h * h * w.qdd[i];
+            w.qd[i] = s.qd[i] + (1.0 - g) * h * s.qdd[i] + g * h * w.qdd[i];
+        }
+    }
+
+    /// One attempted step of size h: Newton-Raphson on q''(t+h) (Eq. 3.10) with the iteration
+    /// matrix of Eq. 3.14, then the error estimate of Eq. 3.15.
+    fn step<S: System + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<StepOutcome, SimError> {
+        let t_new = self.state.t + h;
+        let n = self.state.q.len();
+        self.weights(sys);
+        self.jacobian_fresh = false;
+        let (b, g) = (self.options.beta, self.options.gamma);
+        let orders: Vec<Order> = sys.layout().orders.clone();
+        // Newton corrections are measured on the integrated quantity: q (βh² Δq'') for
+        // second-order coordinates and q' (γh Δq'') for first-order ones.
+        let unit: Vec<f64> = orders.iter().map(|o| match o {
+            Order::Second => b * h * h,
+            Order::First => g * h,
+        }).collect();
+        let converge_at = self.options.newton_tolerance * self.options.tolerance;
+        'attempt: loop {
+            if self.lu.as_ref().map_or(true, |(_, hl)| (hl - h).abs() > 1e-14 * h) {
+                self.factorize(sys, h)?;
+            }
+            self.work.qdd.copy_from(&self.state.qdd);
+            let mut previous = f64::INFINITY;
+            for iteration in 0..self.options.max_iterations {
+                self.update_kinematics(h);
+                sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
+                self.stats.residual_evaluations += 1;
+                self.stats.newton_iterations += 1;
+                if self.work.f.iter().any(|x| !x.is_finite()) {
+                    break;
+                }
+                let rhs = DVector::from_column_slice(&self.work.f);
+                let (lu, _) = self.lu.as_ref().expect("factorized");
+                let Some(dx) = lu.solve(&rhs) else { break };
+                self.work.qdd -= &dx;
+                let norm = (0..n).map(|i| (dx[i] * unit[i] * self.work.weight_q[i]).powi(2)).sum::<f64>().sqrt() / (n as f64).sqrt();
+                if !norm.is_finite() {
+                    break;
+                }
+                if norm <= converge_at {
+                    self.update_kinematics(h);
+                    return Ok(self.accept_or_reject(sys, h));
+                }
+                let contraction = norm / previous;
+                if iteration > 0 && contraction > self.options.slow_contraction && !self.jacobian_fresh {
+                    // Modified Newton is slowing down: refresh the Jacobian and restart the step.
+                    self.refresh_jacobian(sys, t_new);
+                    continue 'attempt;
+                }
+                if contraction > 1.0 && iteration > 1 {
+                    break;
+                }
+                previous = norm;
+            }
+            // Failure with the current Jacobian.
+            if !self.jacobian_fresh {
+                self.refresh_jacobian(sys, t_new);
+                continue 'attempt;
+            }
+            self.stats.rejected_steps += 1;
+            let h_next = h * 0.25;
+            if h_next < self.options.h_min {
+                self.update_kinematics(h);
+                sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
+                check_finite(sys, t_new, &self.work.f)?;
+                return Err(SimError::NewtonDiverged { t: self.state.t, h, rows: largest_rows(sys.layout(), &self.work.f, 5) });
+            }
+            return Ok(StepOutcome::Rejected { h_next });
+        }
+    }
+
+    /// Error estimate of Eq. 3.15, ε = h²/12 · rms(Δq''), with each coordinate weighted by its
+    /// scale; accepts the step when ε ≤ tolerance and proposes the next h.
+    fn accept_or_reject<S: System + ?Sized>(&mut self, _sys: &mut S, h: f64) -> StepOutcome {
+        let n = self.state.q.len();
+        let mut sum = 0.0;
+        for i in 0..n {
+            let d = (self.work.qdd[i] - self.state.qdd[i]) * self.work.weight_q[i];
+            sum += d * d;
+        }
+        let error = h * h / 12.0 * (sum / n as f64).sqrt();
+        let o = &self.options;
+        let ratio = if error > 0.0 { (o.tolerance / error).cbrt() } else { f64::INFINITY };
+        if o.adaptive && error > o.tolerance && h > o.h_min * (1.0 + 1e-9) {
+            self.stats.rejected_steps += 1;
+            let h_next = (h * (0.9 * ratio).clamp(0.1, 0.9)).max(o.h_min);
+            return StepOutcome::Rejected { h_next };
+        }
+        self.state.t += h;
+        self.state.q.copy_from(&self.work.q);
+        self.state.qd.copy_from(&self.work.qd);
+        self.state.qdd.copy_from(&self.work.qdd);
+        self.stats.steps += 1;
+        if o.adaptive {
+            let grow = (0.9 * ratio).clamp(0.2, 2.0);
+            // Keep h (and the factorization) unless the change is worth a new LU.
+            let proposed = (h * grow).clamp(o.h_min, o.h_max);
+            self.h = if proposed >= h && proposed <= 1.25 * self.h.max(h) { self.h.max(h) } else { proposed };
+        } else {
+            self.h = o.h_max;
+        }
+        StepOutcome::Accepted
+    }
+
+    fn fastest_rows<S: System + ?Sized>(&self, sys: &S) -> Vec<super::ResidualRow> {
+        let d: Vec<f64> = (0..self.state.q.len()).map(|i| (self.work.qdd[i] - self.state.qdd[i]) / sys.layout().scales[i]).collect();
+        largest_rows(sys.layout(), &d, 5)
+    }
+}
+
+fn check_finite<S: System + ?Sized>(sys: &S, t: f64, f: &[f64]) -> Result<(), SimError> {
+    if f.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        let rows = largest_rows(sys.layout(), f, 5).into_iter().filter(|r| !r.value.is_finite()).collect();
+        Err(SimError::NonFinite { t, rows })
+    }
+}
