@@ -1,0 +1,113 @@
+//! Equations of motion by the virtual power principle (thesis Eq. 3.37-3.41):
+//! M(q) q̈ + h(q, q̇) = g(q, q̇, t).
+
+use nalgebra::{DMatrix, Matrix3};
+
+use super::data::Data;
+use super::model::Model;
+
+/// Central inertia tensor of body i in the global frame, {Φ_Gi}_0 = R Φ Rᵀ.
+fn world_inertia(model: &Model, data: &Data, i: usize) -> Matrix3<f64> {
+    let r = &data.pose[i].rotation;
+    r * model.bodies[i].inertia * r.transpose()
+}
+
+/// Residual f = M q̈ + h − g of the multibody rows (Eq. 3.37, 3.38) written into `f[..n]`,
+/// without forming M: f_j = Σ_i d_ij·(m_i a_i − R_i) + δ_ij·(Φ_i ω̇_i + ω_i × Φ_i ω_i − M_i) − Q_j.
+/// Needs [`super::kinematics`] and the applied forces of this evaluation.
+pub fn residual(model: &Model, data: &Data, qdd: &[f64], f: &mut [f64]) {
+    let n = model.coordinates;
+    for j in 0..n {
+        f[j] = -data.generalized[j];
+    }
+    for (i, body) in model.bodies.iter().enumerate() {
+        let cols = &body.columns;
+        let d = &data.d[body.offset..body.offset + cols.len()];
+        let delta = &data.delta[body.offset..body.offset + cols.len()];
+        let mut a = data.accel_bias[i];
+        let mut alpha = data.alpha_bias[i];
+        for (k, &c) in cols.iter().enumerate() {
+            a += d[k] * qdd[c];
+            alpha += delta[k] * qdd[c];
+        }
+        let phi = world_inertia(model, data, i);
+        let w = data.omega[i];
+        let lin = a * body.mass - model.gravity * body.mass - data.force[i];
+        let ang = phi * alpha + w.cross(&(phi * w)) - data.moment[i];
+        for (k, &c) in cols.iter().enumerate() {
+            f[c] += d[k].dot(&lin) + delta[k].dot(&ang);
+        }
+    }
+}
+
+/// Mass matrix M(q) (Eq. 3.39) into the top-left n × n block of `m` (overwritten).
+pub fn mass_matrix(model: &Model, data: &Data, m: &mut DMatrix<f64>) {
+    let n = model.coordinates;
+    m.view_mut((0, 0), (n, n)).fill(0.0);
+    for (i, body) in model.bodies.iter().enumerate() {
+        let cols = &body.columns;
+        let d = &data.d[body.offset..body.offset + cols.len()];
+        let delta = &data.delta[body.offset..body.offset + cols.len()];
+        let phi = world_inertia(model, data, i);
+        for (k, &ck) in cols.iter().enumerate() {
+            let md = d[k] * body.mass;
+            let pd = phi * delta[k];
+            for (l, &cl) in cols.iter().enumerate().skip(k) {
+                m[(ck, cl)] += md.dot(&d[l]) + pd.dot(&delta[l]);
+            }
+        }
+    }
+    for r in 0..n {
+        for c in 0..r {
+            m[(r, c)] = m[(c, r)];
+        }
+    }
+    // Columns were visited in sorted order, so (ck <= cl) and the upper triangle is complete.
+}
+
+/// Centrifugal and Coriolis contribution h(q, q̇) (Eq. 3.40).
+pub fn nonlinear_effects(model: &Model, data: &Data) -> Vec<f64> {
+    let mut h = vec![0.0; model.coordinates];
+    for (i, body) in model.bodies.iter().enumerate() {
+        let phi = world_inertia(model, data, i);
+        let w = data.omega[i];
+        let lin = data.accel_bias[i] * body.mass;
+        let ang = phi * data.alpha_bias[i] + w.cross(&(phi * w));
+        for (k, &c) in body.columns.iter().enumerate() {
+            h[c] += data.d[body.offset + k].dot(&lin) + data.delta[body.offset + k].dot(&ang);
+        }
+    }
+    h
+}
+
+/// Applied-force contribution g(q, q̇, t) (Eq. 3.41): gravity, applied wrenches and generalized
+/// forces.
+pub fn generalized_forces(model: &Model, data: &Data) -> Vec<f64> {
+    let mut g = data.generalized.clone();
+    for (i, body) in model.bodies.iter().enumerate() {
+        let r = model.gravity * body.mass + data.force[i];
+        for (k, &c) in body.columns.iter().enumerate() {
+            g[c] += data.d[body.offset + k].dot(&r) + data.delta[body.offset + k].dot(&data.moment[i]);
+        }
+    }
+    g
+}
+
+/// Kinetic energy ½ Σ (m_i v_i² + ω_i·Φ_i ω_i).
+pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
+    model
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let w = data.omega[i];
+            0.5 * (b.mass * data.velocity[i].norm_squared() + w.dot(&(world_inertia(model, data, i) * w)))
+        })
+        .sum()
+}
+
+/// Gravitational potential energy −Σ m_i g·p_i.
+pub fn potential_energy(model: &Model, data: &Data) -> f64 {
+    model.bodies.iter().enumerate().map(|(i, b)| -b.mass * model.gravity.dot(&data.pose[i].translation)).sum()
+}
+

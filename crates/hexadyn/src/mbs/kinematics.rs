@@ -1,0 +1,148 @@
+//! Recursive kinematics with direct partial velocities (thesis Eq. 3.23-3.34, Section 3.3.4).
+//!
+//! Each body is described from its reference body (relative motion): pose, velocity,
+//! convective acceleration and the partial velocities d_ij, δ_ij are carried through the
+//! elementary transforms of the body's joint. A translation by s along unit axis e (global
+//! direction) at offset r adds d_j += δ_j × r + e ∂s/∂q_j; a rotation adds δ_j += e ∂s/∂q_j.
+
+use nalgebra::{DMatrix, Vector3};
+
+use super::data::Data;
+use super::dependent;
+use super::model::{CompiledElementary, CompiledVar, Model, Source};
+use crate::spatial::{rotation_about, Htm};
+
+/// Value, rate, convective second derivative and gradient (per compiled column) of a variable.
+struct VarState {
+    value: f64,
+    rate: f64,
+    bias: f64,
+}
+
+fn var_state(var: &CompiledVar, q: &[f64], qd: &[f64], dependents: &[super::DependentValue]) -> VarState {
+    let v = &var.var;
+    match v.source {
+        Source::Coordinate(j) => VarState { value: v.scale * q[j] + v.offset, rate: v.scale * qd[j], bias: 0.0 },
+        Source::Dependent(k) => {
+            let p = &dependents[k];
+            VarState { value: v.scale * p.value + v.offset, rate: v.scale * p.rate, bias: v.scale * p.bias }
+        }
+    }
+}
+
+/// Adds `e * scale * ∂source/∂q` to the columns of `target`.
+fn add_gradient(var: &CompiledVar, dependents: &[super::DependentValue], e: &Vector3<f64>, target: &mut [Vector3<f64>]) {
+    let v = &var.var;
+    match v.source {
+        Source::Coordinate(_) => target[var.columns[0]] += e * v.scale,
+        Source::Dependent(k) => {
+            for (g, &col) in dependents[k].gradient.iter().zip(&var.columns) {
+                target[col] += e * (v.scale * g);
+            }
+        }
+    }
+}
+
+/// Evaluates dependent parameters, then poses, velocities, convective accelerations and
+/// partial velocities of all bodies at (q, q̇).
+pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
+    debug_assert_eq!(q.len(), model.coordinates);
+    for g in &model.dependents {
+        let (x, xd) = &mut data.input_work;
+        x.clear();
+        xd.clear();
+        x.extend(g.inputs.iter().map(|&i| q[i]));
+        xd.extend(g.inputs.iter().map(|&i| qd[i]));
+        let no = g.function.output_count();
+        let out = &mut data.dependents[g.first_output..g.first_output + no];
+        dependent::evaluate(g.function.as_ref(), x, xd, out, &mut data.dual_work);
+    }
+    for (i, body) in model.bodies.iter().enumerate() {
+        let n = body.columns.len();
+        let (mut pose, mut omega, mut vel, mut alpha, mut acc) = match body.parent {
+            Some(p) => (data.pose[p], data.omega[p], data.velocity[p], data.alpha_bias[p], data.accel_bias[p]),
+            None => (Htm::identity(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
+        };
+        // Columns of this body: start from the parent's.
+        let (head, tail) = data.d.split_at_mut(body.offset);
+        let d = &mut tail[..n];
+        let (dhead, dtail) = data.delta.split_at_mut(body.offset);
+        let delta = &mut dtail[..n];
+        d.iter_mut().for_each(|x| *x = Vector3::zeros());
+        delta.iter_mut().for_each(|x| *x = Vector3::zeros());
+        if let Some(p) = body.parent {
+            let parent = &model.bodies[p];
+            for (k, &pos) in body.parent_columns.iter().enumerate() {
+                d[pos] = head[parent.offset + k];
+                delta[pos] = dhead[parent.offset + k];
+            }
+        }
+        for e in &body.joint {
+            match e {
+                CompiledElementary::Fixed(h) => {
+                    let r = pose.rotation * h.translation;
+                    vel += omega.cross(&r);
+                    acc += alpha.cross(&r) + omega.cross(&omega.cross(&r));
+                    for k in 0..n {
+                        d[k] += delta[k].cross(&r);
+                    }
+                    pose = pose.compose(h);
+                }
+                CompiledElementary::Rotation { axis, var } => {
+                    let s = var_state(var, q, qd, &data.dependents);
+                    let e = pose.rotation * axis;
+                    alpha += omega.cross(&e) * s.rate + e * s.bias;
+                    omega += e * s.rate;
+                    add_gradient(var, &data.dependents, &e, delta);
+                    pose.rotation *= rotation_about(axis, s.value);
+                }
+                CompiledElementary::Translation { axis, var } => {
+                    let s = var_state(var, q, qd, &data.dependents);
+                    let e = pose.rotation * axis;
+                    let r = e * s.value;
+                    vel += omega.cross(&r) + e * s.rate;
+                    acc += alpha.cross(&r) + omega.cross(&omega.cross(&r)) + omega.cross(&e) * (2.0 * s.rate) + e * s.bias;
+                    for k in 0..n {
+                        d[k] += delta[k].cross(&r);
+                    }
+                    add_gradient(var, &data.dependents, &e, d);
+                    pose.translation += r;
+                }
+            }
+        }
+        data.pose[i] = pose;
+        data.omega[i] = omega;
+        data.velocity[i] = vel;
+        data.alpha_bias[i] = alpha;
+        data.accel_bias[i] = acc;
+    }
+}
+
+/// Partial velocities estimated by numerical derivation of the positions (central differences
+/// on T_{0,i}(q), Eq. 3.24 and 3.30): the slow method of the first rows of Table 3.2, kept as the
+/// baseline of the benchmarks and as a test oracle. Returns, per body, J_S and J_ω (3 × n).
+pub fn partial_velocities_numerical(model: &Model, data: &mut Data, q: &[f64]) -> Vec<(DMatrix<f64>, DMatrix<f64>)> {
+    let n = model.coordinates;
+    let zero = vec![0.0; n];
+    let mut x = q.to_vec();
+    let mut out = vec![(DMatrix::zeros(3, n), DMatrix::zeros(3, n)); model.bodies.len()];
+    for j in 0..n {
+        let step = 1e-6 * q[j].abs().max(1.0);
+        x[j] = q[j] + step;
+        kinematics(model, data, &x, &zero);
+        let plus = data.pose.clone();
+        x[j] = q[j] - step;
+        kinematics(model, data, &x, &zero);
+        let minus = data.pose.clone();
+        x[j] = q[j];
+        for (i, (js, jw)) in out.iter_mut().enumerate() {
+            let dp = (plus[i].translation - minus[i].translation) / (2.0 * step);
+            let dr = (plus[i].rotation - minus[i].rotation) / (2.0 * step);
+            let w = dr * ((plus[i].rotation + minus[i].rotation) * 0.5).transpose();
+            js.set_column(j, &dp);
+            jw.set_column(j, &Vector3::new(w[(2, 1)] - w[(1, 2)], w[(0, 2)] - w[(2, 0)], w[(1, 0)] - w[(0, 1)]).scale(0.5));
+        }
+    }
+    kinematics(model, data, q, &zero);
+    out
+}

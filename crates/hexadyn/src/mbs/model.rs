@@ -1,0 +1,309 @@
+//! The immutable multibody description.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::dependent::DependentFunction;
+use crate::spatial::Htm;
+
+/// Index of a body in its [`Model`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BodyId(pub usize);
+
+/// A scalar variable of an elementary transform: `scale * source + offset`, the source being a
+/// configuration parameter q_j or a dependent parameter p_k.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Var {
+    pub source: Source,
+    pub scale: f64,
+    pub offset: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    Coordinate(usize),
+    Dependent(usize),
+}
+
+impl Var {
+    /// q_j.
+    pub fn q(j: usize) -> Var {
+        Var { source: Source::Coordinate(j), scale: 1.0, offset: 0.0 }
+    }
+    /// p_k (index returned by [`ModelBuilder::add_dependent`] plus the output number).
+    pub fn p(k: usize) -> Var {
+        Var { source: Source::Dependent(k), scale: 1.0, offset: 0.0 }
+    }
+    pub fn scaled(mut self, s: f64) -> Var {
+        self.scale *= s;
+        self.offset *= s;
+        self
+    }
+    pub fn plus(mut self, c: f64) -> Var {
+        self.offset += c;
+        self
+    }
+}
+
+/// One factor of a body's HTM relative to its reference body (Appendix A).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Elementary {
+    /// A constant HTM.
+    Fixed(Htm),
+    /// T^R about a unit axis of the current frame by the angle `var` (Eq. A.2-A.4).
+    Rotation { axis: Vector3<f64>, var: Var },
+    /// T^d along a unit axis of the current frame by the length `var` (Eq. A.1).
+    Translation { axis: Vector3<f64>, var: Var },
+}
+
+impl Elementary {
+    /// Constant T^d(x, y, z).
+    pub fn offset(x: f64, y: f64, z: f64) -> Self {
+        Elementary::Fixed(Htm::displacement(x, y, z))
+    }
+    pub fn rx(var: Var) -> Self {
+        Elementary::Rotation { axis: Vector3::x(), var }
+    }
+    pub fn ry(var: Var) -> Self {
+        Elementary::Rotation { axis: Vector3::y(), var }
+    }
+    pub fn rz(var: Var) -> Self {
+        Elementary::Rotation { axis: Vector3::z(), var }
+    }
+    pub fn tx(var: Var) -> Self {
+        Elementary::Translation { axis: Vector3::x(), var }
+    }
+    pub fn ty(var: Var) -> Self {
+        Elementary::Translation { axis: Vector3::y(), var }
+    }
+    pub fn tz(var: Var) -> Self {
+        Elementary::Translation { axis: Vector3::z(), var }
+    }
+}
+
+/// What the user gives for one body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodySpec {
+    pub name: String,
+    /// Reference body (relative motion); `None` for the ground.
+    pub parent: Option<BodyId>,
+    /// T_{parent, body} as a product of elementary HTMs, ending at the centre of gravity.
+    pub joint: Vec<Elementary>,
+    pub mass: f64,
+    /// Central inertia tensor Φ_G in the body frame.
+    pub inertia: Matrix3<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    #[error("body {body}: parent {parent} must be defined before the body")]
+    ParentOrder { body: String, parent: usize },
+    #[error("body {body}: {what}")]
+    Invalid { body: String, what: String },
+    #[error("coordinate index {index} out of range (the model has {count} coordinates)")]
+    Coordinate { index: usize, count: usize },
+    #[error("dependent parameter index {index} out of range ({count} defined)")]
+    Dependent { index: usize, count: usize },
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct DependentGroup {
+    pub inputs: Vec<usize>,
+    pub first_output: usize,
+    pub function: Arc<dyn DependentFunction>,
+}
+
+/// A compiled scalar variable: where its value comes from and which body columns it moves.
+#[derive(Clone, Debug)]
+pub(crate) struct CompiledVar {
+    pub var: Var,
+    /// For each input of the source (1 for a coordinate): position in the body's column list.
+    pub columns: Vec<usize>,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) enum CompiledElementary {
+    Fixed(Htm),
+    Rotation { axis: Vector3<f64>, var: CompiledVar },
+    Translation { axis: Vector3<f64>, var: CompiledVar },
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct Body {
+    pub name: String,
+    pub parent: Option<usize>,
+    pub joint: Vec<CompiledElementary>,
+    pub mass: f64,
+    pub inertia: Matrix3<f64>,
+    /// Sorted configuration parameters this body's motion depends on (its non-zero columns of
+    /// J_S and J_ω).
+    pub columns: Vec<usize>,
+    /// Position in `columns` of each of the parent's columns.
+    pub parent_columns: Vec<usize>,
+    /// Offset of this body's columns in the flat partial-velocity arrays of [`super::Data`].
+    pub offset: usize,
+}
+
+/// Immutable multibody description (Model/Data split). Cheap to clone: dependent functions
+/// are shared.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub(crate) coordinates: usize,
+    pub(crate) bodies: Vec<Body>,
+    pub(crate) dependents: Vec<DependentGroup>,
+    pub(crate) dependent_count: usize,
+    pub(crate) column_total: usize,
+    /// Gravity acceleration in the global frame (m/s²).
+    pub gravity: Vector3<f64>,
+}
+
+impl Model {
+    pub fn coordinate_count(&self) -> usize {
+        self.coordinates
+    }
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+    pub fn body_name(&self, id: BodyId) -> &str {
+        &self.bodies[id.0].name
+    }
+    pub fn body_mass(&self, id: BodyId) -> f64 {
+        self.bodies[id.0].mass
+    }
+    pub fn body_by_name(&self, name: &str) -> Option<BodyId> {
+        self.bodies.iter().position(|b| b.name == name).map(BodyId)
+    }
+    /// Total mass of the system.
+    pub fn total_mass(&self) -> f64 {
+        self.bodies.iter().map(|b| b.mass).sum()
+    }
+    pub fn dependent_count(&self) -> usize {
+        self.dependent_count
+    }
+}
+
+/// Builds a [`Model`] body after body.
+#[derive(Debug)]
+pub struct ModelBuilder {
+    coordinates: usize,
+    specs: Vec<BodySpec>,
+    dependents: Vec<DependentGroup>,
+    dependent_count: usize,
+    gravity: Vector3<f64>,
+}
+
+impl ModelBuilder {
+    /// A model with `coordinates` configuration parameters and gravity -9.81 z.
+    pub fn new(coordinates: usize) -> Self {
+        ModelBuilder { coordinates, specs: Vec::new(), dependents: Vec::new(), dependent_count: 0, gravity: Vector3::new(0.0, 0.0, -9.81) }
+    }
+    pub fn gravity(mut self, g: Vector3<f64>) -> Self {
+        self.gravity = g;
+        self
+    }
+    /// Declares a group of dependent parameters computed from the coordinates `inputs`;
+    /// returns the index of its first output (use `Var::p(first + k)`).
+    pub fn add_dependent(&mut self, inputs: &[usize], function: Arc<dyn DependentFunction>) -> Result<usize, ModelError> {
+        for &i in inputs {
+            if i >= self.coordinates {
+                return Err(ModelError::Coordinate { index: i, count: self.coordinates });
+            }
+        }
+        assert_eq!(inputs.len(), function.input_count(), "dependent function inputs");
+        let first = self.dependent_count;
+        self.dependent_count += function.output_count();
+        self.dependents.push(DependentGroup { inputs: inputs.to_vec(), first_output: first, function });
+        Ok(first)
+    }
+    pub fn add_body(&mut self, spec: BodySpec) -> Result<BodyId, ModelError> {
+        let id = self.specs.len();
+        if let Some(BodyId(p)) = spec.parent {
+            if p >= id {
+                return Err(ModelError::ParentOrder { body: spec.name.clone(), parent: p });
+            }
+        }
+        let bad = |what: String| ModelError::Invalid { body: spec.name.clone(), what };
+        if !(spec.mass >= 0.0 && spec.mass.is_finite()) {
+            return Err(bad(format!("mass {} must be finite and >= 0", spec.mass)));
+        }
+        let sym = (spec.inertia - spec.inertia.transpose()).norm();
+        if !spec.inertia.iter().all(|x| x.is_finite()) || sym > 1e-12 * spec.inertia.norm().max(1e-300) {
+            return Err(bad("inertia tensor must be finite and symmetric".into()));
+        }
+        if spec.inertia.symmetric_eigenvalues().iter().any(|&e| e < -1e-12) {
+            return Err(bad("inertia tensor must be positive semi-definite".into()));
+        }
+        for e in &spec.joint {
+            if let Elementary::Rotation { axis, var } | Elementary::Translation { axis, var } = e {
+                if (axis.norm() - 1.0).abs() > 1e-12 {
+                    return Err(bad(format!("joint axis {axis:?} must be a unit vector")));
+                }
+                match var.source {
+                    Source::Coordinate(j) if j >= self.coordinates => return Err(ModelError::Coordinate { index: j, count: self.coordinates }),
+                    Source::Dependent(k) if k >= self.dependent_count => return Err(ModelError::Dependent { index: k, count: self.dependent_count }),
+                    _ => {}
+                }
+            }
+        }
+        self.specs.push(spec);
+        Ok(BodyId(id))
+    }
+
+    fn source_inputs(&self, source: Source) -> Vec<usize> {
+        match source {
+            Source::Coordinate(j) => vec![j],
+            Source::Dependent(k) => {
+                let g = self.dependents.iter().find(|g| k >= g.first_output && k < g.first_output + g.function.output_count()).expect("validated");
+                g.inputs.clone()
+            }
+        }
+    }
+
+    pub fn build(self) -> Model {
+        let mut bodies: Vec<Body> = Vec::with_capacity(self.specs.len());
+        let mut offset = 0;
+        for spec in &self.specs {
+            let mut columns: Vec<usize> = spec.parent.map(|p| bodies[p.0].columns.clone()).unwrap_or_default();
+            for e in &spec.joint {
+                if let Elementary::Rotation { var, .. } | Elementary::Translation { var, .. } = e {
+                    columns.extend(self.source_inputs(var.source));
+                }
+            }
+            columns.sort_unstable();
+            columns.dedup();
+            let pos = |c: usize| columns.binary_search(&c).expect("column present");
+            let parent_columns = spec.parent.map(|p| bodies[p.0].columns.iter().map(|&c| pos(c)).collect()).unwrap_or_default();
+            let compile = |var: &Var| CompiledVar { var: *var, columns: self.source_inputs(var.source).into_iter().map(pos).collect() };
+            let joint = spec
+                .joint
+                .iter()
+                .map(|e| match e {
+                    Elementary::Fixed(h) => CompiledElementary::Fixed(*h),
+                    Elementary::Rotation { axis, var } => CompiledElementary::Rotation { axis: *axis, var: compile(var) },
+                    Elementary::Translation { axis, var } => CompiledElementary::Translation { axis: *axis, var: compile(var) },
+                })
+                .collect();
+            let n = columns.len();
+            bodies.push(Body {
+                name: spec.name.clone(),
+                parent: spec.parent.map(|p| p.0),
+                joint,
+                mass: spec.mass,
+                inertia: spec.inertia,
+                columns,
+                parent_columns,
+                offset,
+            });
+            offset += n;
+        }
+        Model {
+            coordinates: self.coordinates,
+            bodies,
+            dependents: self.dependents,
+            dependent_count: self.dependent_count,
+            column_total: offset,
+            gravity: self.gravity,
+        }
+    }
+}
