@@ -9,4 +9,5 @@
 
 pub mod mbs;
 pub mod sim;
+pub mod robot;
 pub mod spatial;

@@ -1,0 +1,4 @@
+//! Robot models: leg mechanisms and the hexapod mechanics built from a robot description.
+
+pub mod mechanics;
+pub mod pantograph;
