@@ -137,7 +137,7 @@ def test_mass_matrix_and_bias_forces_match_pinocchio(make):
 def test_bad_input_is_named():
     n, bodies = serial_chain(np.random.default_rng(1), 2)
     bodies[1]["joint"].append(("qz", 0))
-    with pytest.raises(ValueError, match=r"bodies\[1\]: unknown joint element \"qz\""):
+    with pytest.raises(ValueError, match=r"bodies\[1\]: unknown joint element .qz.; allowed: offset"):
         Multibody(n, bodies)
     ours = Multibody(*serial_chain(np.random.default_rng(1), 2))
     with pytest.raises(ValueError, match=r"q\[1\] = nan is not finite"):
