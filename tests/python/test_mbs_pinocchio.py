@@ -140,7 +140,7 @@ def test_bad_input_is_named():
     with pytest.raises(ValueError, match=r"bodies\[1\]: unknown joint element .qz.; allowed: offset"):
         Multibody(n, bodies)
     ours = Multibody(*serial_chain(np.random.default_rng(1), 2))
-    with pytest.raises(ValueError, match=r"q\[1\] = nan is not finite"):
+    with pytest.raises(ValueError, match=r"q\[1\] = NaN is not finite"):
         ours.mass_matrix(np.array([0.0, np.nan]))
     with pytest.raises(ValueError, match="q has 3 entries; the model has 2 coordinates"):
         ours.mass_matrix(np.zeros(3))
