@@ -7,6 +7,7 @@
 //! - [`mbs`]: minimal-coordinates multibody systems, equations of motion by the virtual power
 //!   principle (Section 3.3.3-3.3.4).
 
+pub mod analysis;
 pub mod mbs;
 pub mod sim;
 pub mod robot;

@@ -1,0 +1,3 @@
+//! Analyses built on the model: controller design (thesis Chapter 4).
+
+pub mod pi_design;
