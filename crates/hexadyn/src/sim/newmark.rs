@@ -118,7 +118,8 @@ impl Newmark {
         let n = sys.layout().len();
         assert_eq!(q0.len(), n, "q0 has {} entries, the system {}", q0.len(), n);
         assert_eq!(qd0.len(), n, "qd0 has {} entries, the system {}", qd0.len(), n);
-        let h = options.h_initial.clamp(options.h_min, options.h_max);
+        // Fixed-step mode uses h_max from the first step on (see `NewmarkOptions::adaptive`).
+        let h = if options.adaptive { options.h_initial.clamp(options.h_min, options.h_max) } else { options.h_max };
         let mut nm = Newmark {
             options,
             state: State { t: t0, q: DVector::from_column_slice(q0), qd: DVector::from_column_slice(qd0), qdd: DVector::zeros(n) },
