@@ -176,7 +176,8 @@ impl Newmark {
         Ok(())
     }
 
-    /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15). Inputs are held constant.
+    /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15): on return `state().t == t_end`.
+    /// Inputs are held constant.
     pub fn advance_to<S: System + ?Sized>(&mut self, sys: &mut S, t_end: f64) -> Result<(), SimError> {
         if t_end < self.state.t {
             return Err(SimError::Backwards { requested: t_end, current: self.state.t });
@@ -207,6 +208,9 @@ impl Newmark {
                 }
             }
         }
+        // A remainder below `eps` is not worth a step: the state is taken as the one at t_end, so
+        // that `state().t` is exactly the requested instant.
+        self.state.t = t_end;
         Ok(())
     }
 
