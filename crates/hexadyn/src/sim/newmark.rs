@@ -271,10 +271,12 @@ impl Newmark {
         }).collect();
         let converge_at = self.options.newton_tolerance * self.options.tolerance;
         'attempt: loop {
+            // Predictor q''(t+h) = q''(t) first: a missing Jacobian is evaluated there.
+            self.work.qdd.copy_from(&self.state.qdd);
+            self.update_kinematics(h);
             if self.lu.as_ref().map_or(true, |(_, hl)| (hl - h).abs() > 1e-14 * h) {
                 self.factorize(sys, h)?;
             }
-            self.work.qdd.copy_from(&self.state.qdd);
             let mut previous = f64::INFINITY;
             for iteration in 0..self.options.max_iterations {
                 self.update_kinematics(h);

@@ -333,3 +333,35 @@ pub fn fit_slope(x: &[f64], y: &[f64]) -> f64 {
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }
+
+/// A particle of mass m in polar coordinates (r, θ) held by a radial spring of stiffness k and
+/// free length r0 (no analytic Jacobian):
+///   row 0 (r, "radial spring"): m r'' − m r θ'² + k (r − r0) = 0
+///   row 1 (theta, "particle"):  m r² θ'' + 2 m r r' θ' = 0
+/// The θ row vanishes identically at r = 0, a point the motion never visits.
+pub struct Polar {
+    pub layout: Layout,
+    pub m: f64,
+    pub k: f64,
+    pub r0: f64,
+}
+
+impl Polar {
+    pub fn new(m: f64, k: f64, r0: f64) -> Self {
+        let mut layout = Layout::default();
+        layout.push("r", Order::Second, 1.0, "radial spring");
+        layout.push("theta", Order::Second, 1.0, "particle");
+        Polar { layout, m, k, r0 }
+    }
+}
+
+impl System for Polar {
+    fn layout(&self) -> &Layout {
+        &self.layout
+    }
+    fn residual(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        let (m, r) = (self.m, q[0]);
+        f[0] = m * qdd[0] - m * r * qd[1] * qd[1] + self.k * (r - self.r0);
+        f[1] = m * r * r * qdd[1] + 2.0 * m * r * qd[0] * qd[1];
+    }
+}
