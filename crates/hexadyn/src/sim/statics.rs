@@ -53,7 +53,7 @@ pub fn static_equilibrium<S: System + ?Sized>(
     for iteration in 0..=options.max_iterations {
         let worst = free.iter().map(|&i| f[i].abs()).fold(0.0, f64::max);
         if !worst.is_finite() {
-            return Err(SimError::NonFinite { t, rows: largest_rows(sys.layout(), &f, 5) });
+            return Err(SimError::NonFinite { t, h: None, rows: largest_rows(sys.layout(), &f, 5) });
         }
         if worst <= options.residual_tolerance {
             return Ok(());
