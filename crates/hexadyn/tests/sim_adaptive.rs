@@ -107,7 +107,8 @@ fn rejected_steps_are_counted() {
     assert!((nm.state().q[0] - qe).abs() < 1e-4, "{} vs {qe}", nm.state().q[0]);
 }
 
-/// `advance_to` lands exactly on every requested instant, including awkward ones (1/3, 0.1 + 0.2,
+/// `advance_to` (the NewmarkInterval() of Section 3.3.2, steps from Eq. 3.15) lands exactly on
+/// every requested instant, including awkward ones (1/3, 0.1 + 0.2,
 /// an instant a few ulps after the current time, one closer than the minimum step), and the steps
 /// taken on the way never exceed h_max.
 #[test]

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use hexadyn::sim::{Newmark, NewmarkOptions, SimError};
 
-/// A residual row that turns NaN for t > 0.5 s ("leaky valve", coordinate "y"): the step is cut
+/// A residual row (Eq. 3.1) that turns NaN for t > 0.5 s ("leaky valve", coordinate "y"): the step is cut
 /// down to the minimum step around t = 0.5 and `advance_to` returns SimError::NonFinite whose
 /// message names t = 0.500000 s, the step size, the row's coordinate "y" and element "leaky valve"
 /// (and not the healthy row "x"/"spring"). The state stays at the last good instant, just before 0.5.
@@ -40,7 +40,7 @@ fn nan_residual_is_reported_with_time_step_and_row() {
 }
 
 /// A row with no real solution at all, y''² + y'' + 1 = 0 ("magic brake"), starting at t = 0.25:
-/// Newton never converges, the step is divided down to h_min and `advance_to` returns
+/// Newton (Eq. 3.10) never converges, the step is divided down to h_min and `advance_to` returns
 /// SimError::NewtonDiverged whose message names t = 0.250000 s, the step h, and the coordinate "y"
 /// with its element "magic brake" as the largest residual (≥ 3/4, the minimum of y''² + y'' + 1).
 /// This must hold down to the default h_min = 1e-10 s, where a correction of q'' measured in q
@@ -67,7 +67,7 @@ fn impossible_equation_is_reported_with_time_step_and_row() {
     }
 }
 
-/// A residual that is NaN from the start is refused by `Newmark::new` (consistent initial
+/// A residual (Eq. 3.1) that is NaN from the start is refused by `Newmark::new` (consistent initial
 /// accelerations cannot be computed) with SimError::NonFinite naming the start time, the
 /// coordinate and the element, and no step (there is none yet).
 #[test]

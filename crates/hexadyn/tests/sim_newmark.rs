@@ -151,7 +151,7 @@ fn gamma_above_one_half_damps_high_frequencies() {
     assert!(e_max < 4.0 * e0, "overshoot {}", e_max / e0);
 }
 
-/// With `adaptive: false` the step is h_max from the very first step (h_initial plays no role):
+/// With `adaptive: false` the Newmark step (Eq. 3.7-3.8) is h_max from the very first step (h_initial plays no role):
 /// integrating 1 s with h_max = 0.01 takes exactly 100 steps.
 #[test]
 fn fixed_step_is_h_max_from_the_first_step() {
@@ -201,7 +201,7 @@ fn invalid_options_are_refused() {
     }
 }
 
-/// `advance_to` refuses to integrate backwards (SimError::Backwards) and leaves the state alone.
+/// `advance_to` (step-by-step integration of Eq. 3.7-3.10) refuses to integrate backwards (SimError::Backwards) and leaves the state alone.
 #[test]
 fn advance_to_refuses_to_go_backwards() {
     let mut sys = Linear::oscillator(1.0, 0.0, 1.0);

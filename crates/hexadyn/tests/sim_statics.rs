@@ -6,7 +6,8 @@ mod common;
 use common::*;
 use hexadyn::sim::{static_equilibrium, SimError, StaticOptions};
 
-/// Inverted pendulum held by a torsion spring, m l² θ'' + k θ − m g l sin θ = 0 (θ from the
+/// Static equilibrium f(q, 0, 0, t) = 0 (Eq. 3.1 at rest). Inverted pendulum held by a torsion
+/// spring, m l² θ'' + k θ − m g l sin θ = 0 (θ from the
 /// upright): the spring is chosen as k = m g l sin θ*/θ* with θ* = π/3, so the nonlinear
 /// equilibrium k θ = m g l sin θ has the closed-form root θ*. Newton from θ = 1.3 rad (with a
 /// non-zero initial velocity, which must be zeroed) finds it within 1e-12 rad (residual tolerance
@@ -27,7 +28,7 @@ fn pendulum_with_torsion_spring() {
     }
 }
 
-/// Hanging pendulum under a constant torque u: m g l sin θ = u, θ = asin(u / (m g l)), within
+/// Static equilibrium (Eq. 3.1 at rest) of a hanging pendulum under a constant torque u: m g l sin θ = u, θ = asin(u / (m g l)), within
 /// 1e-12 rad (residual tolerance 1e-12 N·m).
 #[test]
 fn pendulum_under_constant_torque() {
@@ -40,11 +41,12 @@ fn pendulum_under_constant_torque() {
     assert!((q[0] - 0.6_f64.asin()).abs() < 1e-12, "theta {}", q[0]);
 }
 
-/// Three masses hanging in a vertical chain (x downward, from the unstretched springs; springs
+/// Static equilibrium (Eq. 3.1 at rest) of three masses hanging in a vertical chain (x downward, from the unstretched springs; springs
 /// ground–1, 1–2, 2–3, no bottom spring) under gravity m_i g:
 /// - free: x1 = (m1+m2+m3) g/k1, x2 = x1 + (m2+m3) g/k2, x3 = x2 + m3 g/k3;
 /// - with x1 locked at a: x1 stays exactly a, x2 = a + (m2+m3) g/k2, x3 = x2 + m3 g/k3, and the
 ///   residual of the locked row is the reaction (m1+m2+m3) g − k1 a, not zero.
+///
 /// All within 1e-12 m.
 #[test]
 fn hanging_chain_with_locked_coordinate() {
@@ -83,7 +85,7 @@ fn hanging_chain_with_locked_coordinate() {
     assert!((f[0] - reaction).abs() < 1e-9, "locked row residual {} vs reaction {reaction}", f[0]);
 }
 
-/// Equilibrium with a first-order state: for the motor-driven mass at constant voltage the unknown
+/// Equilibrium (Eq. 3.1 with q' = 0 for second-order and y' = q'' = 0 for first-order states): for the motor-driven mass at constant voltage the unknown
 /// of the motor row is the current i = q' (not q): i = V/R and x = kt i / k, within 1e-12.
 #[test]
 fn motor_driven_mass_at_rest() {
@@ -98,7 +100,7 @@ fn motor_driven_mass_at_rest() {
     assert_eq!(q[1], 123.0, "q of a first-order state is meaningless and must be left alone");
 }
 
-/// A torque larger than m g l cannot be held by a pendulum: static_equilibrium fails with
+/// No root of Eq. 3.1 at rest: a torque larger than m g l cannot be held by a pendulum: static_equilibrium fails with
 /// NoEquilibrium, naming the coordinate "theta" and the element "pendulum".
 #[test]
 fn impossible_equilibrium_is_reported() {
@@ -112,7 +114,7 @@ fn impossible_equilibrium_is_reported() {
     assert!(msg.contains("theta") && msg.contains("pendulum"), "{msg}");
 }
 
-/// Converging on the very last allowed iteration is success: the hanging chain (linear, so Newton
+/// Converging (Eq. 3.1 at rest) on the very last allowed Newton iteration is success: the hanging chain (linear, so Newton
 /// converges in one iteration) with max_iterations = 1 succeeds.
 #[test]
 fn convergence_on_the_last_iteration_counts() {

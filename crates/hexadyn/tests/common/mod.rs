@@ -96,7 +96,7 @@ impl System for Linear {
             log.push(t);
         }
         let n = self.n();
-        for i in 0..n {
+        for (i, fi) in f.iter_mut().enumerate().take(n) {
             let mut r = -self.load[i];
             for j in 0..n {
                 r += self.m[(i, j)] * qdd[j] + self.c[(i, j)] * qd[j] + self.k[(i, j)] * q[j];
@@ -104,7 +104,7 @@ impl System for Linear {
             for (k, u) in self.u.iter().enumerate() {
                 r -= self.b[(i, k)] * u;
             }
-            f[i] = r;
+            *fi = r;
         }
     }
     fn jacobian(&mut self, _t: f64, _q: &[f64], _qd: &[f64], _qdd: &[f64], jac: &mut Jacobian) -> bool {
