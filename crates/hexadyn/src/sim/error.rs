@@ -21,14 +21,19 @@ fn list_rows(r: &[ResidualRow]) -> String {
     r.iter().map(|x| x.to_string()).collect::<Vec<_>>().join("; ")
 }
 
+fn step(h: &Option<f64>) -> String {
+    h.map(|h| format!(" with the step h = {h:.3e} s")).unwrap_or_default()
+}
+
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SimError {
     #[error("Newton-Raphson did not converge at t = {t:.6} s with the minimum step h = {h:.3e} s; largest residuals: {}", list_rows(.rows))]
     NewtonDiverged { t: f64, h: f64, rows: Vec<ResidualRow> },
     #[error("the error estimate (Eq. 3.15) stays above tolerance at t = {t:.6} s with the minimum step h = {h:.3e} s (error {error:.3e}); fastest-changing rows: {}", list_rows(.rows))]
     StepTooSmall { t: f64, h: f64, error: f64, rows: Vec<ResidualRow> },
-    #[error("non-finite residual at t = {t:.6} s: {}", list_rows(.rows))]
-    NonFinite { t: f64, rows: Vec<ResidualRow> },
+    /// `h` is the step being attempted (None outside a time step: initial accelerations, statics).
+    #[error("non-finite residual at t = {t:.6} s{}: {}", step(.h), list_rows(.rows))]
+    NonFinite { t: f64, h: Option<f64>, rows: Vec<ResidualRow> },
     #[error("singular {what} matrix at t = {t:.6} s")]
     Singular { what: &'static str, t: f64 },
     #[error("static equilibrium not found after {iterations} iterations; largest residuals: {}", list_rows(.rows))]

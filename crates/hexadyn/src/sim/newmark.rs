@@ -20,7 +20,8 @@ pub struct NewmarkOptions {
     pub h_min: f64,
     pub h_max: f64,
     /// Newton stops when the scaled correction of the integrated quantities is below
-    /// `newton_tolerance` × `tolerance`.
+    /// `newton_tolerance` × `tolerance` and the correction of each q'' is below
+    /// `newton_tolerance` × |q''| (plus the correction the first test allows at h_max).
     pub newton_tolerance: f64,
     /// Newton iterations allowed per step before the Jacobian is refreshed or the step reduced.
     pub max_iterations: usize,
@@ -118,7 +119,8 @@ impl Newmark {
         let n = sys.layout().len();
         assert_eq!(q0.len(), n, "q0 has {} entries, the system {}", q0.len(), n);
         assert_eq!(qd0.len(), n, "qd0 has {} entries, the system {}", qd0.len(), n);
-        let h = options.h_initial.clamp(options.h_min, options.h_max);
+        // Fixed-step mode uses h_max from the first step on (see `NewmarkOptions::adaptive`).
+        let h = if options.adaptive { options.h_initial.clamp(options.h_min, options.h_max) } else { options.h_max };
         let mut nm = Newmark {
             options,
             state: State { t: t0, q: DVector::from_column_slice(q0), qd: DVector::from_column_slice(qd0), qdd: DVector::zeros(n) },
@@ -160,7 +162,7 @@ impl Newmark {
         for _ in 0..self.options.max_iterations {
             sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
             self.stats.residual_evaluations += 1;
-            check_finite(sys, t, &self.work.f)?;
+            check_finite(sys, t, None, &self.work.f)?;
             let jac = Jacobian::evaluate(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
             self.stats.jacobian_evaluations += 1;
             let Some(dx) = LU::new(jac.m.clone()).solve(&DVector::from_column_slice(&self.work.f)) else {
@@ -175,7 +177,8 @@ impl Newmark {
         Ok(())
     }
 
-    /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15). Inputs are held constant.
+    /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15): on return `state().t == t_end`.
+    /// Inputs are held constant.
     pub fn advance_to<S: System + ?Sized>(&mut self, sys: &mut S, t_end: f64) -> Result<(), SimError> {
         if t_end < self.state.t {
             return Err(SimError::Backwards { requested: t_end, current: self.state.t });
@@ -206,6 +209,9 @@ impl Newmark {
                 }
             }
         }
+        // A remainder below `eps` is not worth a step: the state is taken as the one at t_end, so
+        // that `state().t` is exactly the requested instant.
+        self.state.t = t_end;
         Ok(())
     }
 
@@ -265,11 +271,30 @@ impl Newmark {
             Order::First => g * h,
         }).collect();
         let converge_at = self.options.newton_tolerance * self.options.tolerance;
+        // The last correction must also be small against q'' itself (`newton_tolerance` relative),
+        // with an absolute floor equal to what the test above allows at h_max: as h → 0 the
+        // q-unit test alone accepts any bounded q'' (βh² Δq'' vanishes), so an iteration that
+        // does not converge at all, e.g. on a residual without a root, would pass silently.
+        let h_ref = if self.options.h_max.is_finite() { self.options.h_max.max(h) } else { h };
+        let floor: Vec<f64> = orders
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                converge_at / self.work.weight_q[i]
+                    / match o {
+                        Order::Second => b * h_ref * h_ref,
+                        Order::First => g * h_ref,
+                    }
+            })
+            .collect();
+        let relative = self.options.newton_tolerance;
         'attempt: loop {
+            // Predictor q''(t+h) = q''(t) first: a missing Jacobian is evaluated there.
+            self.work.qdd.copy_from(&self.state.qdd);
+            self.update_kinematics(h);
             if self.lu.as_ref().map_or(true, |(_, hl)| (hl - h).abs() > 1e-14 * h) {
                 self.factorize(sys, h)?;
             }
-            self.work.qdd.copy_from(&self.state.qdd);
             let mut previous = f64::INFINITY;
             for iteration in 0..self.options.max_iterations {
                 self.update_kinematics(h);
@@ -287,7 +312,7 @@ impl Newmark {
                 if !norm.is_finite() {
                     break;
                 }
-                if norm <= converge_at {
+                if norm <= converge_at && (0..n).all(|i| dx[i].abs() <= relative * self.work.qdd[i].abs() + floor[i]) {
                     self.update_kinematics(h);
                     return Ok(self.accept_or_reject(sys, h));
                 }
@@ -304,16 +329,22 @@ impl Newmark {
             }
             // Failure with the current Jacobian.
             if !self.jacobian_fresh {
+                if self.work.qdd.iter().any(|x| !x.is_finite()) {
+                    // The iteration blew up: evaluate the Jacobian at the predictor instead.
+                    self.work.qdd.copy_from(&self.state.qdd);
+                    self.update_kinematics(h);
+                }
                 self.refresh_jacobian(sys, t_new);
                 continue 'attempt;
             }
             self.stats.rejected_steps += 1;
+            // This Jacobian belongs to a failed step (possibly evaluated where the residual is not
+            // finite): the next attempt evaluates its own rather than inherit a poisoned one.
+            self.jacobian = None;
+            self.lu = None;
             let h_next = h * 0.25;
             if h_next < self.options.h_min {
-                self.update_kinematics(h);
-                sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
-                check_finite(sys, t_new, &self.work.f)?;
-                return Err(SimError::NewtonDiverged { t: self.state.t, h, rows: largest_rows(sys.layout(), &self.work.f, 5) });
+                return Err(self.newton_failure(sys, t_new, h));
             }
             return Ok(StepOutcome::Rejected { h_next });
         }
@@ -352,17 +383,39 @@ impl Newmark {
         StepOutcome::Accepted
     }
 
+    /// The error for a step that Newton cannot solve even at the minimum step: the residual at
+    /// the last iterate (NewtonDiverged), or its non-finite rows (NonFinite), taken at the
+    /// predictor when the residual is not finite there already.
+    fn newton_failure<S: System + ?Sized>(&mut self, sys: &mut S, t_new: f64, h: f64) -> SimError {
+        self.update_kinematics(h);
+        sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
+        self.stats.residual_evaluations += 1;
+        if self.work.f.iter().all(|x| x.is_finite()) {
+            return SimError::NewtonDiverged { t: self.state.t, h, rows: largest_rows(sys.layout(), &self.work.f, 5) };
+        }
+        let iterate = self.work.f.clone();
+        self.work.qdd.copy_from(&self.state.qdd);
+        self.update_kinematics(h);
+        sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
+        self.stats.residual_evaluations += 1;
+        let f = if self.work.f.iter().all(|x| x.is_finite()) { &iterate } else { &self.work.f };
+        match check_finite(sys, t_new, Some(h), f) {
+            Err(e) => e,
+            Ok(()) => unreachable!("non-finite residual checked above"),
+        }
+    }
+
     fn fastest_rows<S: System + ?Sized>(&self, sys: &S) -> Vec<super::ResidualRow> {
         let d: Vec<f64> = (0..self.state.q.len()).map(|i| (self.work.qdd[i] - self.state.qdd[i]) / sys.layout().scales[i]).collect();
         largest_rows(sys.layout(), &d, 5)
     }
 }
 
-fn check_finite<S: System + ?Sized>(sys: &S, t: f64, f: &[f64]) -> Result<(), SimError> {
+fn check_finite<S: System + ?Sized>(sys: &S, t: f64, h: Option<f64>, f: &[f64]) -> Result<(), SimError> {
     if f.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
         let rows = largest_rows(sys.layout(), f, 5).into_iter().filter(|r| !r.value.is_finite()).collect();
-        Err(SimError::NonFinite { t, rows })
+        Err(SimError::NonFinite { t, h, rows })
     }
 }

@@ -48,13 +48,18 @@ pub fn static_equilibrium<S: System + ?Sized>(
         free.iter().map(|&i| f[i] * f[i]).sum::<f64>().sqrt()
     };
     let mut current = norm(sys, q, qd, &mut f);
-    for _ in 0..options.max_iterations {
+    // `max_iterations` Newton updates, each followed by the convergence test (the last update is
+    // tested too).
+    for iteration in 0..=options.max_iterations {
         let worst = free.iter().map(|&i| f[i].abs()).fold(0.0, f64::max);
         if !worst.is_finite() {
-            return Err(SimError::NonFinite { t, rows: largest_rows(sys.layout(), &f, 5) });
+            return Err(SimError::NonFinite { t, h: None, rows: largest_rows(sys.layout(), &f, 5) });
         }
         if worst <= options.residual_tolerance {
             return Ok(());
+        }
+        if iteration == options.max_iterations {
+            break;
         }
         let jac = Jacobian::evaluate(sys, t, q, qd, &qdd);
         let k = free.len();
