@@ -5,8 +5,15 @@
 //! - [`sim`]: systems in residual form f(q, q', q'', t) = 0 and their Newmark integration,
 //!   static equilibrium and linearization (Section 3.3.2);
 //! - [`mbs`]: minimal-coordinates multibody systems, equations of motion by the virtual power
-//!   principle (Section 3.3.3-3.3.4).
+//!   principle (Section 3.3.3-3.3.4);
+//! - [`physics`]: ground contact, joint friction and DC motors (Section 3.4.2-3.4.4, Chapter 5);
+//! - [`control`]: joint controllers and encoders (Section 3.4.4, Chapter 4).
 
+pub mod control;
 pub mod mbs;
+pub mod physics;
 pub mod sim;
 pub mod spatial;
+
+#[cfg(test)]
+mod test_util;
