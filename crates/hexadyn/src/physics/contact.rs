@@ -1,0 +1,284 @@
+//! Compliant foot-ground contact (thesis Section 3.4.2, Eq. 3.72-3.74, Table 3.3).
+//!
+//! The foot is a point, the ground a surface described by a [`Terrain`]; the contact is computed
+//! against the tangent plane of the terrain below the foot. Every vector is in the global frame.
+
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A ground surface z = h(x, y).
+pub trait Terrain {
+    /// Height h of the ground below (x, y) and its unit normal n there, pointing out of the
+    /// ground (n_z > 0).
+    fn height_normal(&self, x: f64, y: f64) -> (f64, Vector3<f64>);
+}
+
+/// Horizontal ground at z = `height`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FlatGround {
+    pub height: f64,
+}
+
+impl Terrain for FlatGround {
+    fn height_normal(&self, _x: f64, _y: f64) -> (f64, Vector3<f64>) {
+        (self.height, Vector3::z())
+    }
+}
+
+/// Inclined plane z = height + slope_x x + slope_y y.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Slope {
+    pub height: f64,
+    /// ∂h/∂x.
+    pub slope_x: f64,
+    /// ∂h/∂y.
+    pub slope_y: f64,
+}
+
+impl Slope {
+    /// A plane through (0, 0, `height`) rising at `angle` (rad) in the horizontal direction
+    /// `azimuth` (rad from x_0 about z_0).
+    pub fn from_angle(height: f64, angle: f64, azimuth: f64) -> Self {
+        let t = angle.tan();
+        Slope { height, slope_x: t * azimuth.cos(), slope_y: t * azimuth.sin() }
+    }
+}
+
+impl Terrain for Slope {
+    fn height_normal(&self, x: f64, y: f64) -> (f64, Vector3<f64>) {
+        (self.height + self.slope_x * x + self.slope_y * y, Vector3::new(-self.slope_x, -self.slope_y, 1.0).normalize())
+    }
+}
+
+/// Parameters of the contact law, Eq. 3.72-3.73.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GroundContact {
+    /// Stiffness K_gnd (N/m^p_K).
+    pub k_gnd: f64,
+    /// Damping D_gnd (N s/m^(p_D+1)).
+    pub d_gnd: f64,
+    /// Penetration exponent p_K (1.5: Hertz contact of a sphere on a half space, Eq. 3.74).
+    pub p_k: f64,
+    /// Penetration-rate exponent p_D.
+    pub p_d: f64,
+    /// Friction coefficient μ.
+    pub mu: f64,
+    /// Slip velocity v_glim of the linear zone of the Coulomb friction (m/s).
+    pub v_glim: f64,
+}
+
+impl Default for GroundContact {
+    /// Table 3.3.
+    fn default() -> Self {
+        GroundContact { k_gnd: 1e6, d_gnd: 5e4, p_k: 1.5, p_d: 0.5, mu: 0.3, v_glim: 1e-4 }
+    }
+}
+
+/// The force of the ground on the foot and its exact Jacobians.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactForce {
+    /// F = F_n n + F_t (N).
+    pub force: Vector3<f64>,
+    /// F_n ≥ 0 (N).
+    pub normal_force: f64,
+    /// δ = n · (p_s - p), positive inside the ground, negative (the clearance) above it (m).
+    pub penetration: f64,
+    /// dδ/dt = -n · v (m/s).
+    pub penetration_rate: f64,
+    /// Tangential velocity v_g of the foot relative to the ground (m/s).
+    pub slip_velocity: Vector3<f64>,
+    /// ∂F/∂p.
+    pub df_dp: Matrix3<f64>,
+    /// ∂F/∂v.
+    pub df_dv: Matrix3<f64>,
+    /// Power the contact takes from the robot, -F · v (W): the rate of the ground elastic
+    /// energy plus the dissipated power.
+    pub absorbed_power: f64,
+    /// Power dissipated in the contact (W), ≥ 0: -F · v minus the rate of [`Self::elastic_energy`].
+    pub dissipated_power: f64,
+    /// Energy stored in the ground spring, K δ^(p_K+1) / (p_K + 1) (J).
+    pub elastic_energy: f64,
+}
+
+impl GroundContact {
+    /// Contact force on a foot at `p` moving at `v` (the ground is fixed), Eq. 3.72-3.73.
+    ///
+    /// The penetration is measured against the tangent plane below the foot: δ = n · (p_s - p)
+    /// with p_s = (x, y, h(x, y)) and n the terrain normal there. The Jacobians treat that plane
+    /// as fixed (∂δ/∂p = -nᵀ): exact for planar terrains, the curvature × penetration terms are
+    /// neglected on curved ones.
+    ///
+    /// For δ > 0, F_n = K δ^p_K + D δ^p_D dδ/dt (Eq. 3.72), clamped at zero: the ground never
+    /// pulls the foot (no adhesion when the foot leaves the ground faster than the damping
+    /// allows). With p_D < 1, ∂F_n/∂p contains D p_D δ^(p_D-1) dδ/dt, unbounded as δ → 0 while
+    /// dδ/dt ≠ 0. The friction is Coulomb with a linear zone (Eq. 3.73) on the tangential slip
+    /// velocity v_g = v - (n · v) n.
+    pub fn force<T: Terrain + ?Sized>(&self, p: &Vector3<f64>, v: &Vector3<f64>, terrain: &T) -> ContactForce {
+        let (h, n) = terrain.height_normal(p.x, p.y);
+        let delta = n.z * (h - p.z);
+        let delta_rate = -n.dot(v);
+        let projector = Matrix3::identity() - n * n.transpose();
+        let slip = projector * v;
+        let mut out = ContactForce {
+            force: Vector3::zeros(),
+            normal_force: 0.0,
+            penetration: delta,
+            penetration_rate: delta_rate,
+            slip_velocity: slip,
+            df_dp: Matrix3::zeros(),
+            df_dv: Matrix3::zeros(),
+            absorbed_power: 0.0,
+            dissipated_power: 0.0,
+            elastic_energy: 0.0,
+        };
+        if delta <= 0.0 {
+            return out;
+        }
+        let spring = self.k_gnd * delta.powf(self.p_k);
+        let damping = self.d_gnd * delta.powf(self.p_d);
+        out.elastic_energy = spring * delta / (self.p_k + 1.0);
+        let f_n = spring + damping * delta_rate;
+        if f_n > 0.0 {
+            // ∂F_n/∂δ and ∂F_n/∂(dδ/dt); ∂δ/∂p = ∂(dδ/dt)/∂v = -nᵀ.
+            let dfn_ddelta = self.p_k * spring / delta + self.p_d * damping / delta * delta_rate;
+            let dfn_dp = -dfn_ddelta * n.transpose();
+            let dfn_dv = -damping * n.transpose();
+            let speed = slip.norm();
+            let (friction, dft_dp, dft_dv) = if speed < self.v_glim {
+                let c = self.mu / self.v_glim;
+                (-c * f_n * slip, -c * slip * dfn_dp, -c * (slip * dfn_dv + f_n * projector))
+            } else {
+                let u = slip / speed;
+                (-self.mu * f_n * u, -self.mu * u * dfn_dp, -self.mu * (u * dfn_dv + f_n / speed * (projector - u * u.transpose())))
+            };
+            out.normal_force = f_n;
+            out.force = f_n * n + friction;
+            out.df_dp = n * dfn_dp + dft_dp;
+            out.df_dv = n * dfn_dv + dft_dv;
+        }
+        out.absorbed_power = -out.force.dot(v);
+        out.dissipated_power = out.absorbed_power - spring * delta_rate;
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::{assert_partial, central, noise, rng};
+    use rand::Rng;
+
+    /// Central differences of F in p and v with steps `hp`, `hv` that cross no kink.
+    fn finite_difference_check(contact: &GroundContact, terrain: &dyn Terrain, p: Vector3<f64>, v: Vector3<f64>, hp: f64, hv: f64) {
+        let c = contact.force(&p, &v, terrain);
+        let scale = c.force.norm();
+        for j in 0..3 {
+            for i in 0..3 {
+                let fp = |x: f64| {
+                    let mut q = p;
+                    q[j] = x;
+                    contact.force(&q, &v, terrain).force[i]
+                };
+                let fv = |x: f64| {
+                    let mut w = v;
+                    w[j] = x;
+                    contact.force(&p, &w, terrain).force[i]
+                };
+                let what = format!("∂F_{i}/∂p_{j} at δ = {:e}, v = {v:?}", c.penetration);
+                assert_partial(&what, c.df_dp[(i, j)], central(fp, p[j], hp), 1e-5, 1e-8 * c.df_dp.norm() + noise(scale, hp));
+                let what = format!("∂F_{i}/∂v_{j} at δ = {:e}, v = {v:?}", c.penetration);
+                assert_partial(&what, c.df_dv[(i, j)], central(fv, v[j], hv), 1e-5, 1e-8 * c.df_dv.norm() + noise(scale, hv));
+            }
+        }
+    }
+
+    #[test]
+    fn jacobians_match_finite_differences() {
+        let contact = GroundContact::default();
+        let flat = FlatGround { height: 0.02 };
+        let slope = Slope::from_angle(-0.1, 20f64.to_radians(), 0.7);
+        let mut r = rng(21);
+        for k in 0..400 {
+            let terrain: &dyn Terrain = if k % 2 == 0 { &flat } else { &slope };
+            let (x, y) = (r.random_range(-1.0..1.0), r.random_range(-1.0..1.0));
+            let (h, n) = terrain.height_normal(x, y);
+            let delta = (r.random_range((1e-6f64).ln()..(5e-3f64).ln())).exp();
+            let p = Vector3::new(x, y, h - delta / n.z);
+            // Slip inside or outside the linear zone of Eq. 3.73, penetration rate of either sign
+            // (F_n stays above 5 % of K δ^p_K: away from the no-adhesion clamp).
+            let t1 = n.cross(&Vector3::x()).normalize();
+            let t2 = n.cross(&t1);
+            let slip = contact.v_glim * if k % 4 < 2 { r.random_range(0.01..0.99) } else { r.random_range(1.01..100.0) };
+            let a = r.random_range(0.0..std::f64::consts::TAU);
+            let rate = r.random_range(-0.95..2.0) * contact.k_gnd * delta / contact.d_gnd;
+            let v = slip * (a.cos() * t1 + a.sin() * t2) - rate * n;
+            let c = contact.force(&p, &v, terrain);
+            assert!(c.normal_force > 0.05 * contact.k_gnd * delta.powf(1.5));
+            assert!((c.slip_velocity.norm() - slip).abs() < 1e-9 * slip);
+            finite_difference_check(&contact, terrain, p, v, 1e-4 * delta, 1e-4 * slip.min((slip - contact.v_glim).abs()));
+        }
+    }
+
+    #[test]
+    fn static_normal_force_follows_hertz() {
+        let contact = GroundContact::default();
+        let ground = FlatGround { height: 0.0 };
+        for delta in [1e-5, 1e-4, 2.3e-3] {
+            let c = contact.force(&Vector3::new(0.3, -0.2, -delta), &Vector3::zeros(), &ground);
+            let hertz = contact.k_gnd * f64::powf(delta, 1.5);
+            assert!((c.normal_force - hertz).abs() < 1e-12 * hertz);
+            assert!((c.force - Vector3::new(0.0, 0.0, hertz)).norm() < 1e-12 * hertz);
+            assert!((c.penetration - delta).abs() < 1e-15);
+        }
+        // Table 3.3 calibration: about 2.3 mm under a third of the 34 kg robot (Section 3.4.2).
+        let delta = (34.0 * 9.81 / 3.0 / contact.k_gnd).powf(1.0 / 1.5);
+        assert!((delta - 2.3e-3).abs() < 0.1e-3, "{delta}");
+    }
+
+    #[test]
+    fn friction_saturates_at_mu_normal_force() {
+        let contact = GroundContact::default();
+        let ground = FlatGround { height: 0.0 };
+        let p = Vector3::new(0.0, 0.0, -1e-3);
+        for speed in [1e-3, 1e-2, 1.0] {
+            let c = contact.force(&p, &Vector3::new(0.6 * speed, -0.8 * speed, 0.0), &ground);
+            let ft = c.force - c.normal_force * Vector3::z();
+            assert!((ft.norm() - contact.mu * c.normal_force).abs() < 1e-12 * c.normal_force);
+            assert!(ft.dot(&c.slip_velocity) < 0.0);
+        }
+        let c = contact.force(&p, &Vector3::new(0.5 * contact.v_glim, 0.0, 0.0), &ground);
+        assert!((c.force.x + 0.5 * contact.mu * c.normal_force).abs() < 1e-12 * c.normal_force);
+    }
+
+    #[test]
+    fn no_force_above_ground_and_no_adhesion() {
+        let contact = GroundContact::default();
+        let slope = Slope::from_angle(0.0, 0.3, 1.0);
+        let (h, _) = slope.height_normal(0.2, 0.1);
+        let above = contact.force(&Vector3::new(0.2, 0.1, h + 1e-4), &Vector3::new(0.1, 0.0, -0.1), &slope);
+        assert_eq!(above.force, Vector3::zeros());
+        assert_eq!(above.df_dp, Matrix3::zeros());
+        assert!(above.penetration < 0.0);
+        // Leaving the ground fast: the damping would pull, the force is clamped at zero.
+        let ground = FlatGround { height: 0.0 };
+        let leaving = contact.force(&Vector3::new(0.0, 0.0, -1e-4), &Vector3::new(0.0, 0.0, 1.0), &ground);
+        assert_eq!(leaving.normal_force, 0.0);
+        assert_eq!(leaving.force, Vector3::zeros());
+        assert!(leaving.dissipated_power > 0.0);
+    }
+
+    #[test]
+    fn dissipated_power_is_non_negative() {
+        let contact = GroundContact::default();
+        let ground = FlatGround { height: 0.0 };
+        let mut r = rng(22);
+        for _ in 0..1000 {
+            let p = Vector3::new(0.0, 0.0, -r.random_range(0.0..5e-3));
+            let v = Vector3::new(r.random_range(-1e-3..1e-3), r.random_range(-1e-3..1e-3), r.random_range(-0.1..0.1));
+            let c = contact.force(&p, &v, &ground);
+            assert!(c.dissipated_power >= -1e-12 * (1.0 + c.absorbed_power.abs()), "{c:?}");
+            let elastic_rate = contact.k_gnd * c.penetration.max(0.0).powf(1.5) * c.penetration_rate;
+            assert!((c.absorbed_power - c.dissipated_power - elastic_rate).abs() < 1e-9 * (1.0 + c.absorbed_power.abs()));
+        }
+    }
+}

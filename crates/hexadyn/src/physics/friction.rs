@@ -1,0 +1,655 @@
+//! Joint friction (thesis Section 3.4.3, Chapter 5 and Section 6.1).
+//!
+//! Sign convention: every law returns the friction torque τ_f that opposes the motion, as in the
+//! thesis (Eq. 3.79, 3.87, 6.1: τ_f > 0 when q' > 0); the generalized force the friction applies
+//! to the joint is -τ_f. For a translational joint the "torque" is a force in N and q' is in m/s
+//! (footnote of Eq. 3.86).
+//!
+//! Direction-dependent parameters (Section 6.1): the `_pos` parameters hold for q' ≥ 0 and the
+//! `_neg` ones for q' < 0. As in Tables 5.3-5.5, the negative-direction dry friction τ_f,d^-,
+//! stiction τ_f,s^- and load coefficients a_2^-, a_1^- are negative numbers, while both viscous
+//! coefficients f_v^± are non-negative (Eq. 6.1 adds f_v^- q' with q' < 0).
+//!
+//! Non-smooth points: |q'| and the switch between `_pos` and `_neg` parameters make the laws
+//! non-differentiable at q' = 0 (Eq. 6.1 also at q' = ±ε); the values are continuous there.
+//! Every partial derivative returned at such a point is the one-sided derivative of the branch
+//! that owns the point: q' = 0 belongs to the q' ≥ 0 branch (right derivative, d|q'|/dq' = +1 with
+//! the `_pos` parameters) and q' = ±ε to the linear zone of Eq. 6.1.
+//!
+//! Per joint, the quantities worth recording are the friction torque ([`FrictionTorque::tau`]),
+//! the bristle state z = q'_z and the load fed to [`FrictionElement`].
+
+use serde::{Deserialize, Serialize};
+
+/// Half width ε of the linear zone of Eq. 6.1 (rad/s or m/s), Section 6.1.
+pub const LINEAR_ZONE: f64 = 1e-4;
+/// Bristle stiffness σ0 of Table 6.1 (Nm/rad or N/m; the table's "1e-9" lost its sign).
+pub const BRISTLE_STIFFNESS: f64 = 1e9;
+/// Bristle damping σ1 of Table 6.1 (Nms/rad or Ns/m).
+pub const BRISTLE_DAMPING: f64 = 0.02;
+/// Stribeck velocity q'_st of the vertical joints, Table 6.1 (m/s).
+pub const STRIBECK_VELOCITY: f64 = 1e-4;
+/// Weight of one kilogram (N/kg): the foot loads of Section 5.4 are masses hung at the foot
+/// (Section 5.3 uses 9.81 m/s²), so a load force F enters Eq. 5.12 as x = F / LOAD_GRAVITY kg.
+pub const LOAD_GRAVITY: f64 = 9.81;
+
+/// A friction parameter outside its physical range.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("invalid friction parameter {parameter} = {value}: expected {expected}")]
+pub struct FrictionError {
+    pub parameter: &'static str,
+    pub value: f64,
+    pub expected: &'static str,
+}
+
+fn require(parameter: &'static str, value: f64, ok: bool, expected: &'static str) -> Result<(), FrictionError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(FrictionError { parameter, value, expected })
+    }
+}
+
+/// Whether q' uses the `_pos` parameters (Section 6.1: q' ≥ 0).
+fn positive(qd: f64) -> bool {
+    qd >= 0.0
+}
+
+/// Dry/viscous friction with a linear zone around zero velocity, Eq. 6.1.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DryViscous {
+    /// τ_f,d^+ ≥ 0 (Nm or N).
+    pub tau_d_pos: f64,
+    /// τ_f,d^- ≤ 0 (Nm or N).
+    pub tau_d_neg: f64,
+    /// f_v^+ ≥ 0 (Nms/rad or Ns/m).
+    pub f_v_pos: f64,
+    /// f_v^- ≥ 0 (Nms/rad or Ns/m).
+    pub f_v_neg: f64,
+    /// Half width ε > 0 of the linear zone (rad/s or m/s).
+    pub epsilon: f64,
+}
+
+impl DryViscous {
+    /// Eq. 6.1 with ε = [`LINEAR_ZONE`], from the identified parameters of Table 5.3; negative
+    /// (non-physical) viscous coefficients are forced to zero as in Section 6.1.
+    pub fn new(tau_d_pos: f64, tau_d_neg: f64, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
+        let law = DryViscous { tau_d_pos, tau_d_neg, f_v_pos: f_v_pos.max(0.0), f_v_neg: f_v_neg.max(0.0), epsilon: LINEAR_ZONE };
+        law.validate()?;
+        Ok(law)
+    }
+
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        require("tau_d_pos", self.tau_d_pos, self.tau_d_pos >= 0.0, ">= 0")?;
+        require("tau_d_neg", self.tau_d_neg, self.tau_d_neg <= 0.0, "<= 0 (negative-direction dry friction, Table 5.3)")?;
+        require("f_v_pos", self.f_v_pos, self.f_v_pos >= 0.0, ">= 0")?;
+        require("f_v_neg", self.f_v_neg, self.f_v_neg >= 0.0, ">= 0")?;
+        require("epsilon", self.epsilon, self.epsilon > 0.0, "> 0")
+    }
+
+    /// Dry friction of the direction of q'.
+    fn dry(&self, qd: f64) -> f64 {
+        if positive(qd) {
+            self.tau_d_pos
+        } else {
+            self.tau_d_neg
+        }
+    }
+
+    /// τ_f(q') and ∂τ_f/∂q', Eq. 6.1.
+    pub fn torque(&self, qd: f64) -> (f64, f64) {
+        let (tau, dtau_dqd, _) = self.torque_with_dry(qd, self.dry(qd));
+        (tau, dtau_dqd)
+    }
+
+    /// Eq. 6.1 with the dry friction `tau_d` of the direction of q' (unloaded or Eq. 5.12):
+    /// (τ_f, ∂τ_f/∂q', ∂τ_f/∂τ_d).
+    ///
+    /// The linear zone joins the origin to the value of the outer branch at q' = ±ε, so that τ_f
+    /// is continuous. Eq. 6.1 prints the slope (τ_f,d^- + f_v^- ε)/ε for -ε ≤ q' < 0, which with
+    /// the negative τ_f,d^- of Table 5.3 would reverse the friction in that zone; the continuous
+    /// slope is (f_v^- ε - τ_f,d^-)/ε.
+    fn torque_with_dry(&self, qd: f64, tau_d: f64) -> (f64, f64, f64) {
+        let eps = self.epsilon;
+        if qd > eps {
+            (tau_d + self.f_v_pos * qd, self.f_v_pos, 1.0)
+        } else if qd >= 0.0 {
+            let slope = (tau_d + self.f_v_pos * eps) / eps;
+            (slope * qd, slope, qd / eps)
+        } else if qd >= -eps {
+            let slope = (self.f_v_neg * eps - tau_d) / eps;
+            (slope * qd, slope, -qd / eps)
+        } else {
+            (tau_d + self.f_v_neg * qd, self.f_v_neg, 1.0)
+        }
+    }
+}
+
+/// Steady-state function of the LuGre model, σ0 g(q') (Section 6.1).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum SteadyState {
+    /// Dry friction only, g = τ_f,d^+ / σ0 for q' ≥ 0 and -τ_f,d^- / σ0 for q' < 0: the
+    /// rotational joints (Eq. 6.2-6.3) and the horizontal joints (Eq. 5.4, 6.5).
+    Dry { tau_d_pos: f64, tau_d_neg: f64 },
+    /// With the Stribeck effect, g = |τ_f,d + (τ_f,s - τ_f,d) exp(-(q'/q'_st)²)| / σ0: the
+    /// vertical joints (Eq. 3.86, 6.4). τ_f,s^± are the stiction of Table 5.4 (10 kg load; the
+    /// unloaded dry friction where Table 5.4 has no value, Section 6.1).
+    Stribeck { tau_d_pos: f64, tau_d_neg: f64, tau_s_pos: f64, tau_s_neg: f64, qd_st: f64 },
+}
+
+impl SteadyState {
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        match *self {
+            SteadyState::Dry { tau_d_pos, tau_d_neg } => {
+                require("tau_d_pos", tau_d_pos, tau_d_pos > 0.0, "> 0 (g must be positive)")?;
+                require("tau_d_neg", tau_d_neg, tau_d_neg < 0.0, "< 0 (g must be positive)")
+            }
+            SteadyState::Stribeck { tau_d_pos, tau_d_neg, tau_s_pos, tau_s_neg, qd_st } => {
+                require("tau_d_pos", tau_d_pos, tau_d_pos > 0.0, "> 0 (g must be positive)")?;
+                require("tau_d_neg", tau_d_neg, tau_d_neg < 0.0, "< 0 (g must be positive)")?;
+                require("tau_s_pos", tau_s_pos, tau_s_pos > 0.0, "> 0 (g must be positive)")?;
+                require("tau_s_neg", tau_s_neg, tau_s_neg < 0.0, "< 0 (g must be positive)")?;
+                require("qd_st", qd_st, qd_st > 0.0, "> 0")
+            }
+        }
+    }
+
+    /// Unloaded dry friction τ_f,d of the direction of q'.
+    pub fn dry(&self, qd: f64) -> f64 {
+        let (SteadyState::Dry { tau_d_pos, tau_d_neg } | SteadyState::Stribeck { tau_d_pos, tau_d_neg, .. }) = *self;
+        if positive(qd) {
+            tau_d_pos
+        } else {
+            tau_d_neg
+        }
+    }
+
+    /// Signed steady-state friction s(q') = σ0 g(q') sgn(q') for the dry friction `tau_d` of the
+    /// direction of q': (s, ∂s/∂q', ∂s/∂τ_d). Its sign is the direction's (positive for q' ≥ 0).
+    fn level(&self, qd: f64, tau_d: f64) -> (f64, f64, f64) {
+        match *self {
+            SteadyState::Dry { .. } => (tau_d, 0.0, 1.0),
+            SteadyState::Stribeck { tau_s_pos, tau_s_neg, qd_st, .. } => {
+                let tau_s = if positive(qd) { tau_s_pos } else { tau_s_neg };
+                let r = qd / qd_st;
+                let e = (-r * r).exp();
+                (tau_d + (tau_s - tau_d) * e, (tau_s - tau_d) * e * (-2.0 * r / qd_st), 1.0 - e)
+            }
+        }
+    }
+}
+
+/// The LuGre model in the residual form of the thesis (Eq. 3.85-3.87, Section 6.1): the bristle
+/// deflection is the first-order state z = q'_z, z' = q''_z.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LuGre {
+    /// Bristle stiffness σ0 > 0 (Nm/rad or N/m).
+    pub sigma_0: f64,
+    /// Bristle damping σ1 ≥ 0 at zero velocity (Nms/rad or Ns/m).
+    pub sigma_1: f64,
+    /// Velocity v_d > 0 of the vanishing damping σ1(q') = σ1 exp(-(q'/v_d)²), Eq. 3.84
+    /// (`f64::INFINITY` keeps σ1 constant).
+    pub v_d: f64,
+    /// f_v^+ ≥ 0 (Nms/rad or Ns/m).
+    pub f_v_pos: f64,
+    /// f_v^- ≥ 0 (Nms/rad or Ns/m).
+    pub f_v_neg: f64,
+    pub steady: SteadyState,
+}
+
+impl LuGre {
+    /// The LuGre law with σ0, σ1 of Table 6.1 and v_d = q'_st of Table 6.1 (Olsson's choice of
+    /// v_d "in relation to the Stribeck velocity", Section 3.4.3; the thesis gives no value).
+    /// Negative (non-physical) viscous coefficients are forced to zero as in Section 6.1.
+    pub fn new(steady: SteadyState, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
+        let law = LuGre {
+            sigma_0: BRISTLE_STIFFNESS,
+            sigma_1: BRISTLE_DAMPING,
+            v_d: STRIBECK_VELOCITY,
+            f_v_pos: f_v_pos.max(0.0),
+            f_v_neg: f_v_neg.max(0.0),
+            steady,
+        };
+        law.validate()?;
+        Ok(law)
+    }
+
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        require("sigma_0", self.sigma_0, self.sigma_0 > 0.0, "> 0")?;
+        require("sigma_1", self.sigma_1, self.sigma_1 >= 0.0, ">= 0")?;
+        if self.v_d.is_nan() || self.v_d <= 0.0 {
+            return Err(FrictionError { parameter: "v_d", value: self.v_d, expected: "> 0 (infinity for a constant sigma_1)" });
+        }
+        require("f_v_pos", self.f_v_pos, self.f_v_pos >= 0.0, ">= 0")?;
+        require("f_v_neg", self.f_v_neg, self.f_v_neg >= 0.0, ">= 0")?;
+        self.steady.validate()
+    }
+
+    fn viscous(&self, qd: f64) -> f64 {
+        if positive(qd) {
+            self.f_v_pos
+        } else {
+            self.f_v_neg
+        }
+    }
+
+    /// Unloaded steady-state function g(q') > 0 (m or rad), Eq. 6.2-6.5.
+    pub fn g(&self, qd: f64) -> f64 {
+        self.steady.level(qd, self.steady.dry(qd)).0.abs() / self.sigma_0
+    }
+
+    /// σ1(q') and dσ1/dq', Eq. 3.84.
+    pub fn sigma_1_at(&self, qd: f64) -> (f64, f64) {
+        let r = qd / self.v_d;
+        let s = self.sigma_1 * (-r * r).exp();
+        (s, s * (-2.0 * r / self.v_d))
+    }
+
+    /// Dissipativity condition of Eq. 3.83 at q': 0 ≤ σ1(q') ≤ 4 σ0 g(q') / |q'| (unloaded g).
+    pub fn dissipative(&self, qd: f64) -> bool {
+        let (s1, _) = self.sigma_1_at(qd);
+        s1 >= 0.0 && s1 * qd.abs() <= 4.0 * self.sigma_0 * self.g(qd)
+    }
+
+    /// Bristle residual of Eq. 3.85, f_z = q''_z - q' + |q'| / g(q') q'_z, with z = q'_z and
+    /// z' = q''_z: (f_z, ∂f_z/∂q', ∂f_z/∂z, ∂f_z/∂z').
+    pub fn bristle_residual(&self, qd: f64, z: f64, zdot: f64) -> (f64, f64, f64, f64) {
+        let (f, df_dqd, df_dz, df_dzdot, _) = self.bristle_residual_with_dry(qd, z, zdot, self.steady.dry(qd));
+        (f, df_dqd, df_dz, df_dzdot)
+    }
+
+    /// Eq. 3.85 with the dry friction `tau_d` of the direction of q' (unloaded or Eq. 5.12), plus
+    /// ∂f_z/∂τ_d. Since g and q' share their sign convention, |q'| / g(q') = σ0 q' / s(q') with
+    /// s the signed steady-state friction, which is how it is evaluated.
+    fn bristle_residual_with_dry(&self, qd: f64, z: f64, zdot: f64, tau_d: f64) -> (f64, f64, f64, f64, f64) {
+        let (s, ds_dqd, ds_dtau_d) = self.steady.level(qd, tau_d);
+        let rate = self.sigma_0 * qd / s;
+        let drate_dqd = self.sigma_0 / s - rate * ds_dqd / s;
+        let drate_dtau_d = -rate * ds_dtau_d / s;
+        (zdot - qd + rate * z, -1.0 + drate_dqd * z, rate, 1.0, drate_dtau_d * z)
+    }
+
+    /// Friction torque of Eq. 3.87, τ_f = σ0 q'_z + σ1(q') q''_z + f_v q':
+    /// (τ_f, ∂τ_f/∂q', ∂τ_f/∂z, ∂τ_f/∂z').
+    pub fn torque(&self, qd: f64, z: f64, zdot: f64) -> (f64, f64, f64, f64) {
+        let (s1, ds1_dqd) = self.sigma_1_at(qd);
+        let f_v = self.viscous(qd);
+        (self.sigma_0 * z + s1 * zdot + f_v * qd, ds1_dqd * zdot + f_v, self.sigma_0, s1)
+    }
+}
+
+/// Load dependence of the dry friction of a horizontal joint, Eq. 5.12 (Section 5.4, 6.4.4):
+/// τ̃_f,d = a_2 x² + a_1 x + a_0 with x the foot load in kg (Table 5.5 is in N/kg² and N/kg) and
+/// a_0 the unloaded dry friction of the law it modifies (Table 5.3, Section 6.4.4).
+///
+/// Section 5.4: a_2^±, a_1^± have the sign of a_0^± (positive for q' ≥ 0, negative for q' < 0), so
+/// that |τ̃_f,d| grows with the load and never falls below |a_0|.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LoadDependence {
+    /// a_2^+ ≥ 0 (N/kg²).
+    pub a2_pos: f64,
+    /// a_1^+ ≥ 0 (N/kg).
+    pub a1_pos: f64,
+    /// a_2^- ≤ 0 (N/kg²).
+    pub a2_neg: f64,
+    /// a_1^- ≤ 0 (N/kg).
+    pub a1_neg: f64,
+}
+
+impl LoadDependence {
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        require("a2_pos", self.a2_pos, self.a2_pos >= 0.0, ">= 0 (Section 5.4)")?;
+        require("a1_pos", self.a1_pos, self.a1_pos >= 0.0, ">= 0 (Section 5.4)")?;
+        require("a2_neg", self.a2_neg, self.a2_neg <= 0.0, "<= 0 (Section 5.4)")?;
+        require("a1_neg", self.a1_neg, self.a1_neg <= 0.0, "<= 0 (Section 5.4)")
+    }
+
+    /// τ̃_f,d of the direction of q' for the foot load `load` (N) and its derivative with respect
+    /// to the load (per N), Eq. 5.12 with x = load / [`LOAD_GRAVITY`]. A negative load (which the
+    /// contact model never produces) counts as no load; at zero load the derivative is the right
+    /// one.
+    pub fn dry_friction(&self, a0: f64, qd: f64, load: f64) -> (f64, f64) {
+        if load < 0.0 {
+            return (a0, 0.0);
+        }
+        let (a2, a1) = if positive(qd) { (self.a2_pos, self.a1_pos) } else { (self.a2_neg, self.a1_neg) };
+        let x = load / LOAD_GRAVITY;
+        ((a2 * x + a1) * x + a0, (2.0 * a2 * x + a1) / LOAD_GRAVITY)
+    }
+}
+
+/// Friction law of one joint (Section 6.1: the three cases compared in Chapter 6).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum JointFriction {
+    None,
+    DryViscous(DryViscous),
+    LuGre(LuGre),
+}
+
+impl JointFriction {
+    /// Whether the law has the bristle state z = q'_z (one extra first-order coordinate).
+    pub fn has_bristle_state(&self) -> bool {
+        matches!(self, JointFriction::LuGre(_))
+    }
+
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        match self {
+            JointFriction::None => Ok(()),
+            JointFriction::DryViscous(law) => law.validate(),
+            JointFriction::LuGre(law) => law.validate(),
+        }
+    }
+}
+
+/// Friction torque of a [`FrictionElement`] and its partial derivatives.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrictionTorque {
+    /// τ_f, opposing the motion (the generalized force on the joint is -τ_f).
+    pub tau: f64,
+    pub dtau_dqd: f64,
+    /// With respect to the bristle state z = q'_z (zero without bristle).
+    pub dtau_dz: f64,
+    /// With respect to z' = q''_z (zero without bristle).
+    pub dtau_dzdot: f64,
+    /// With respect to the foot load in N (zero without load dependence).
+    pub dtau_dload: f64,
+}
+
+/// Bristle residual row (Eq. 3.85) of a [`FrictionElement`] and its partial derivatives.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BristleResidual {
+    pub f: f64,
+    pub df_dqd: f64,
+    /// With respect to z = q'_z (a CT entry).
+    pub df_dz: f64,
+    /// With respect to z' = q''_z (an M entry).
+    pub df_dzdot: f64,
+    /// With respect to the foot load in N (zero without load dependence).
+    pub df_dload: f64,
+}
+
+/// The friction element of one joint: a law, optionally with the load-dependent dry friction of
+/// Eq. 5.12 (horizontal joints, Section 6.4.4), which then replaces τ_f,d^± in Eq. 6.1 or in the
+/// steady-state function g (Eq. 5.6).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrictionElement {
+    pub law: JointFriction,
+    pub load: Option<LoadDependence>,
+}
+
+impl FrictionElement {
+    pub fn new(law: JointFriction) -> Self {
+        FrictionElement { law, load: None }
+    }
+
+    pub fn with_load(self, load: LoadDependence) -> Self {
+        FrictionElement { load: Some(load), ..self }
+    }
+
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        self.law.validate()?;
+        self.load.as_ref().map_or(Ok(()), LoadDependence::validate)
+    }
+
+    pub fn has_bristle_state(&self) -> bool {
+        self.law.has_bristle_state()
+    }
+
+    /// The dry friction in force for the direction of q' and the foot load `load` (N): τ_f,d^±
+    /// or τ̃_f,d^± of Eq. 5.12, with its derivative with respect to the load. Zero without friction.
+    pub fn dry_friction(&self, qd: f64, load: f64) -> (f64, f64) {
+        let a0 = match &self.law {
+            JointFriction::None => return (0.0, 0.0),
+            JointFriction::DryViscous(law) => law.dry(qd),
+            JointFriction::LuGre(law) => law.steady.dry(qd),
+        };
+        self.load.map_or((a0, 0.0), |l| l.dry_friction(a0, qd, load))
+    }
+
+    /// Friction torque τ_f(q', z, z', load) with its partials: Eq. 6.1 (z, z' ignored) or Eq. 3.87.
+    pub fn torque(&self, qd: f64, z: f64, zdot: f64, load: f64) -> FrictionTorque {
+        match &self.law {
+            JointFriction::None => FrictionTorque::default(),
+            JointFriction::DryViscous(law) => {
+                let (tau_d, dtau_d_dload) = self.dry_friction(qd, load);
+                let (tau, dtau_dqd, dtau_dtau_d) = law.torque_with_dry(qd, tau_d);
+                FrictionTorque { tau, dtau_dqd, dtau_dz: 0.0, dtau_dzdot: 0.0, dtau_dload: dtau_dtau_d * dtau_d_dload }
+            }
+            JointFriction::LuGre(law) => {
+                let (tau, dtau_dqd, dtau_dz, dtau_dzdot) = law.torque(qd, z, zdot);
+                FrictionTorque { tau, dtau_dqd, dtau_dz, dtau_dzdot, dtau_dload: 0.0 }
+            }
+        }
+    }
+
+    /// Bristle residual of Eq. 3.85 (with g of Eq. 5.6 under load) and its partials; `None` when
+    /// the law has no bristle state.
+    pub fn bristle_residual(&self, qd: f64, z: f64, zdot: f64, load: f64) -> Option<BristleResidual> {
+        let JointFriction::LuGre(law) = &self.law else { return None };
+        let (tau_d, dtau_d_dload) = self.dry_friction(qd, load);
+        let (f, df_dqd, df_dz, df_dzdot, df_dtau_d) = law.bristle_residual_with_dry(qd, z, zdot, tau_d);
+        Some(BristleResidual { f, df_dqd, df_dz, df_dzdot, df_dload: df_dtau_d * dtau_d_dload })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::{assert_partial, central, noise, rng};
+    use rand::Rng;
+
+    /// Vertical joint of leg 0: Table 5.3 (dry, viscous) and Table 5.4 (stiction, 10 kg).
+    fn vertical_leg0() -> LuGre {
+        let steady = SteadyState::Stribeck { tau_d_pos: 335.1, tau_d_neg: -423.6, tau_s_pos: 673.0, tau_s_neg: -679.5, qd_st: STRIBECK_VELOCITY };
+        LuGre::new(steady, 3763.0, 8005.8).unwrap()
+    }
+
+    /// Horizontal joint of leg 0: Table 5.3 (viscous neglected, Section 6.1) and Table 5.5
+    /// (a_1^- is not legible in the table: a made-up value of the right sign).
+    fn horizontal_leg0_load() -> LoadDependence {
+        LoadDependence { a2_pos: 3.84, a1_pos: 20.3, a2_neg: -3.84, a1_neg: -15.0 }
+    }
+
+    fn random_dry_viscous(r: &mut impl Rng) -> DryViscous {
+        DryViscous::new(r.random_range(1.0..500.0), r.random_range(-500.0..-1.0), r.random_range(0.0..2e4), r.random_range(0.0..2e4)).unwrap()
+    }
+
+    fn random_lugre(r: &mut impl Rng, stribeck: bool) -> LuGre {
+        let (tau_d_pos, tau_d_neg) = (r.random_range(1.0..500.0), r.random_range(-500.0..-1.0));
+        let steady = if stribeck {
+            SteadyState::Stribeck {
+                tau_d_pos,
+                tau_d_neg,
+                tau_s_pos: r.random_range(1.0..1500.0),
+                tau_s_neg: r.random_range(-1500.0..-1.0),
+                qd_st: r.random_range(1e-5..1e-3),
+            }
+        } else {
+            SteadyState::Dry { tau_d_pos, tau_d_neg }
+        };
+        let mut law = LuGre::new(steady, r.random_range(0.0..2e4), r.random_range(0.0..2e4)).unwrap();
+        law.sigma_1 = r.random_range(0.0..1.0);
+        law.v_d = r.random_range(1e-5..1e-2);
+        law
+    }
+
+    /// A random velocity of random sign with |q'| log-uniform in [lo, hi].
+    fn velocity(r: &mut impl Rng, lo: f64, hi: f64) -> f64 {
+        let magnitude = (r.random_range(lo.ln()..hi.ln())).exp();
+        if r.random_bool(0.5) {
+            magnitude
+        } else {
+            -magnitude
+        }
+    }
+
+    #[test]
+    fn dry_viscous_partials_match_finite_differences() {
+        let mut r = rng(1);
+        for k in 0..400 {
+            let law = random_dry_viscous(&mut r);
+            let eps = law.epsilon;
+            // Alternate inside and outside the linear zone; the step never crosses a kink.
+            let qd = if k % 2 == 0 { velocity(&mut r, 0.05 * eps, 0.95 * eps) } else { velocity(&mut r, 1.05 * eps, 1e3 * eps) };
+            let h = 1e-3 * qd.abs();
+            let (tau, dtau_dqd) = law.torque(qd);
+            assert_partial("dτ/dq'", dtau_dqd, central(|x| law.torque(x).0, qd, h), 1e-6, noise(tau, h));
+
+            let element = FrictionElement::new(JointFriction::DryViscous(law)).with_load(horizontal_leg0_load());
+            let load = r.random_range(1.0..200.0);
+            let t = element.torque(qd, 0.0, 0.0, load);
+            assert_partial("dτ/dq' (loaded)", t.dtau_dqd, central(|x| element.torque(x, 0.0, 0.0, load).tau, qd, h), 1e-6, noise(t.tau, h));
+            assert_partial("dτ/dload", t.dtau_dload, central(|x| element.torque(qd, 0.0, 0.0, x).tau, load, 1e-2), 1e-6, noise(t.tau, 1e-2));
+        }
+    }
+
+    #[test]
+    fn dry_viscous_is_continuous_dissipative_and_matches_eq_6_1() {
+        let law = DryViscous::new(335.1, -423.6, 3763.0, 8005.8).unwrap();
+        let eps = law.epsilon;
+        for border in [eps, -eps] {
+            let inner = law.torque(border).0;
+            let outer = law.torque(border * (1.0 + 1e-12)).0;
+            assert!((inner - outer).abs() < 1e-6, "discontinuity at {border}: {inner} vs {outer}");
+        }
+        assert_eq!(law.torque(0.0).0, 0.0);
+        assert!((law.torque(1e-3).0 - (335.1 + 3763.0e-3)).abs() < 1e-9);
+        assert!((law.torque(-1e-3).0 - (-423.6 - 8005.8e-3)).abs() < 1e-9);
+        let mut r = rng(2);
+        for _ in 0..1000 {
+            let qd = velocity(&mut r, 1e-8, 1.0);
+            assert!(law.torque(qd).0 * qd > 0.0, "friction must oppose the motion at q' = {qd}");
+        }
+        // At q' = 0 the partial is the right derivative (q' ≥ 0 branch).
+        let h = 1e-9;
+        assert_partial("right derivative", law.torque(0.0).1, (law.torque(h).0 - law.torque(0.0).0) / h, 1e-6, 0.0);
+    }
+
+    #[test]
+    fn negative_viscous_coefficients_are_forced_to_zero_and_signs_checked() {
+        let law = DryViscous::new(465.1, -563.1, -4112.7, 247.5).unwrap();
+        assert_eq!(law.f_v_pos, 0.0);
+        assert!(DryViscous::new(465.1, 563.1, 0.0, 0.0).is_err());
+        assert!(SteadyState::Dry { tau_d_pos: 7.7, tau_d_neg: 8.8 }.validate().is_err());
+        assert!(LoadDependence { a2_pos: 3.84, a1_pos: -1.0, a2_neg: -3.84, a1_neg: 0.0 }.validate().is_err());
+    }
+
+    #[test]
+    fn lugre_partials_match_finite_differences() {
+        let mut r = rng(3);
+        for k in 0..600 {
+            let law = random_lugre(&mut r, k % 2 == 0);
+            let qd = velocity(&mut r, 1e-6, 1e-1);
+            let g = law.g(qd);
+            let z = r.random_range(-2.0 * g..2.0 * g);
+            let zdot = r.random_range(-1e-2..1e-2);
+            let h = 1e-5 * qd.abs();
+            let (hz, hzd) = (1e-3 * g, 1e-5);
+
+            let (f0, df_dqd, df_dz, df_dzdot) = law.bristle_residual(qd, z, zdot);
+            let f = |qd: f64, z: f64, zdot: f64| law.bristle_residual(qd, z, zdot).0;
+            let nf = |h: f64| noise(f0.abs() + 3.0 * qd.abs() + zdot.abs(), h);
+            assert_partial("∂f_z/∂q'", df_dqd, central(|x| f(x, z, zdot), qd, h), 1e-6, nf(h));
+            assert_partial("∂f_z/∂z", df_dz, central(|x| f(qd, x, zdot), z, hz), 1e-6, nf(hz));
+            assert_partial("∂f_z/∂z'", df_dzdot, central(|x| f(qd, z, x), zdot, hzd), 1e-6, nf(hzd));
+
+            let (tau0, dtau_dqd, dtau_dz, dtau_dzdot) = law.torque(qd, z, zdot);
+            let tau = |qd: f64, z: f64, zdot: f64| law.torque(qd, z, zdot).0;
+            let nt = |h: f64| noise(law.sigma_0 * z.abs() + tau0.abs(), h);
+            assert_partial("∂τ/∂q'", dtau_dqd, central(|x| tau(x, z, zdot), qd, h), 1e-6, nt(h));
+            assert_partial("∂τ/∂z", dtau_dz, central(|x| tau(qd, x, zdot), z, hz), 1e-6, nt(hz));
+            assert_partial("∂τ/∂z'", dtau_dzdot, central(|x| tau(qd, z, x), zdot, hzd), 1e-6, nt(hzd));
+
+            let element = FrictionElement::new(JointFriction::LuGre(law)).with_load(horizontal_leg0_load());
+            let load = r.random_range(1.0..200.0);
+            let b = element.bristle_residual(qd, z, zdot, load).unwrap();
+            let fe = |qd: f64, load: f64| element.bristle_residual(qd, z, zdot, load).unwrap().f;
+            assert_partial("∂f_z/∂q' (loaded)", b.df_dqd, central(|x| fe(x, load), qd, h), 1e-6, nf(h));
+            assert_partial("∂f_z/∂load", b.df_dload, central(|x| fe(qd, x), load, 1e-4), 1e-6, nf(1e-4));
+            let t = element.torque(qd, z, zdot, load);
+            assert_eq!((t.tau, t.dtau_dqd, t.dtau_dz, t.dtau_dzdot, t.dtau_dload), (law.torque(qd, z, zdot).0, dtau_dqd, dtau_dz, dtau_dzdot, 0.0));
+        }
+    }
+
+    #[test]
+    fn lugre_derivatives_at_zero_velocity_are_right_derivatives() {
+        let law = vertical_leg0();
+        let (z, zdot) = (2e-7, 1e-4);
+        let h = 1e-10;
+        let (f0, df_dqd, ..) = law.bristle_residual(0.0, z, zdot);
+        assert_partial("right ∂f_z/∂q'", df_dqd, (law.bristle_residual(h, z, zdot).0 - f0) / h, 1e-6, 1e-9);
+        let (t0, dtau_dqd, ..) = law.torque(0.0, z, zdot);
+        assert_partial("right ∂τ/∂q'", dtau_dqd, (law.torque(h, z, zdot).0 - t0) / h, 1e-4, noise(t0, h));
+    }
+
+    #[test]
+    fn lugre_steady_state_reproduces_the_stribeck_curve() {
+        let law = vertical_leg0();
+        let SteadyState::Stribeck { tau_d_pos, tau_d_neg, tau_s_pos, tau_s_neg, qd_st } = law.steady else { unreachable!() };
+        for v in [1e-5, 5e-5, 1e-4, 2e-4, 5e-4, 1e-3, 8e-3, -1e-5, -5e-5, -1e-4, -2e-4, -5e-4, -1e-3, -8e-3] {
+            // Explicit Euler on z' = -f_z(q', z, 0) with a step half the bristle time constant.
+            let dt = 0.5 * law.g(v) / v.abs();
+            let mut z = 0.0;
+            let mut zdot = 0.0;
+            for _ in 0..200 {
+                zdot = -law.bristle_residual(v, z, 0.0).0;
+                z += dt * zdot;
+            }
+            let tau = law.torque(v, z, zdot).0;
+            let (tau_d, tau_s, f_v) = if v >= 0.0 { (tau_d_pos, tau_s_pos, law.f_v_pos) } else { (tau_d_neg, tau_s_neg, law.f_v_neg) };
+            let stribeck = tau_d + (tau_s - tau_d) * (-(v / qd_st).powi(2)).exp() + f_v * v; // Eq. 3.82
+            assert!((tau - stribeck).abs() < 1e-9 * stribeck.abs(), "v = {v}: {tau} vs Eq. 3.82 {stribeck}");
+            assert!((z - law.g(v) * v.signum()).abs() < 1e-12 * law.g(v), "Eq. 3.80 at v = {v}");
+        }
+    }
+
+    #[test]
+    fn lugre_is_dissipative_with_the_thesis_parameters() {
+        let vertical = vertical_leg0();
+        let rotational = LuGre::new(SteadyState::Dry { tau_d_pos: 7.7, tau_d_neg: -8.8 }, 3.4, 22.3).unwrap();
+        let horizontal = LuGre::new(SteadyState::Dry { tau_d_pos: 465.1, tau_d_neg: -563.1 }, 0.0, 0.0).unwrap();
+        let mut constant_damping = vertical;
+        constant_damping.v_d = f64::INFINITY;
+        for law in [vertical, rotational, horizontal, constant_damping] {
+            for k in 0..=90 {
+                let v = 10f64.powf(-9.0 + 0.1 * k as f64); // up to 1 m/s (rad/s)
+                assert!(law.dissipative(v) && law.dissipative(-v), "Eq. 3.83 violated at |q'| = {v} for {law:?}");
+            }
+            assert!(law.dissipative(0.0));
+        }
+        let mut stiff_damping = vertical;
+        stiff_damping.sigma_1 = 1e9;
+        assert!(!stiff_damping.dissipative(1e-5));
+    }
+
+    #[test]
+    fn load_dependence_follows_eq_5_12() {
+        let load = horizontal_leg0_load();
+        let a0 = 465.1;
+        assert_eq!(load.dry_friction(a0, 1e-3, 0.0).0, a0);
+        let ten_kg = 10.0 * LOAD_GRAVITY;
+        assert!((load.dry_friction(a0, 1e-3, ten_kg).0 - (3.84 * 100.0 + 20.3 * 10.0 + a0)).abs() < 1e-9);
+        assert!((load.dry_friction(-563.1, -1e-3, ten_kg).0 - (-3.84 * 100.0 - 15.0 * 10.0 - 563.1)).abs() < 1e-9);
+        let mut r = rng(4);
+        for _ in 0..100 {
+            let (x, qd) = (r.random_range(0.0..300.0), velocity(&mut r, 1e-6, 1e-2));
+            let a0 = if qd >= 0.0 { 465.1 } else { -563.1 };
+            let (value, d) = load.dry_friction(a0, qd, x);
+            assert!(value.abs() >= a0.abs());
+            let x = x.max(1e-2);
+            assert_partial("dτ̃_d/dload", d, central(|l| load.dry_friction(a0, qd, l).0, x, 1e-2), 1e-6, noise(value, 1e-2));
+        }
+        let element = FrictionElement::new(JointFriction::DryViscous(DryViscous::new(465.1, -563.1, 0.0, 0.0).unwrap())).with_load(load);
+        assert!((element.torque(1e-3, 0.0, 0.0, ten_kg).tau - element.dry_friction(1e-3, ten_kg).0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bristle_state_only_for_lugre() {
+        let dry = FrictionElement::new(JointFriction::DryViscous(DryViscous::new(7.7, -8.8, 3.4, 22.3).unwrap()));
+        let lugre = FrictionElement::new(JointFriction::LuGre(vertical_leg0()));
+        let none = FrictionElement::new(JointFriction::None);
+        assert!(!dry.has_bristle_state() && !none.has_bristle_state() && lugre.has_bristle_state());
+        assert!(dry.bristle_residual(1e-3, 0.0, 0.0, 0.0).is_none());
+        assert_eq!(none.torque(1.0, 1.0, 1.0, 1.0), FrictionTorque::default());
+    }
+}

@@ -1,0 +1,17 @@
+//! Physical elements of the robot model (thesis Section 3.4.2-3.4.4, Chapter 5, Section 6.1):
+//! ground contact, joint friction and DC motors.
+//!
+//! Each element is a set of small pure functions returning its value with the exact partial
+//! derivatives with respect to each argument, from which the assembler of the global residual
+//! f(q, q', q'', t) = 0 fills the blocks M = ∂f/∂q'', CT = ∂f/∂q' and KT = ∂f/∂q (Eq. 3.12).
+
+mod contact;
+mod friction;
+mod motor;
+
+pub use contact::{ContactForce, FlatGround, GroundContact, Slope, Terrain};
+pub use friction::{
+    BristleResidual, DryViscous, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,
+    BRISTLE_DAMPING, BRISTLE_STIFFNESS, LINEAR_ZONE, LOAD_GRAVITY, STRIBECK_VELOCITY,
+};
+pub use motor::{limit_switch, saturate, Current, CurrentResidual, DcMotor, H_BRIDGE_RESISTANCE};
