@@ -1,0 +1,74 @@
+# Developer and CI commands. `make run` and `make test` work on a fresh machine with Python >= 3.10
+# and a Rust toolchain: they create .venv, install the pinned dependencies and build the engine.
+
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+LOCK := requirements/lock.txt
+CARGO ?= cargo
+
+# Everything that changes the compiled extension hexadyn._core.
+RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name Cargo.toml 2>/dev/null)
+
+# Stamps inside .venv: removing .venv resets them.
+DEPS_STAMP := $(VENV)/.hexadyn-deps
+BUILD_STAMP := $(VENV)/.hexadyn-build
+
+.PHONY: help setup run test test-rust test-python bench lock clean
+
+help:
+	@echo "make run    set everything up, then run hexadyn on the default scenario"
+	@echo "make test   set everything up, then run the Rust and Python tests"
+	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
+	@echo "make bench  run the engine benchmarks (release)"
+	@echo "make lock   re-resolve requirements/lock.txt and requirements/ray-lock.txt"
+	@echo "make clean  remove .venv and the Cargo target directory"
+
+setup: $(BUILD_STAMP)
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+
+# Pinned dependencies and the editable install (pip runs maturin, which builds _core in release).
+$(DEPS_STAMP): $(LOCK) pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) maturin
+	PATH="$(abspath $(VENV))/bin:$$PATH" \
+	  $(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) --no-build-isolation -e '.[test]'
+	touch $@
+
+# Rebuild the extension in place after a Rust change (the editable install already points here).
+$(BUILD_STAMP): $(DEPS_STAMP) $(RUST_SOURCES)
+	VIRTUAL_ENV=$(abspath $(VENV)) $(VENV)/bin/maturin develop --release --skip-install --quiet
+	touch $@
+
+run: setup
+	$(VENV)/bin/hexadyn simulate
+
+test: setup test-rust test-python
+
+test-rust:
+	$(CARGO) test --workspace --release --exclude hexadyn-py
+
+test-python: setup
+	$(PY) -m pytest -q tests/python
+
+bench:
+	$(CARGO) run --release -p hexadyn-benches --bin engine
+
+# Resolve the locks in throw-away venvs (needs PyPI); review the diff before committing.
+lock:
+	rm -rf .lock-venv
+	$(PYTHON) -m venv .lock-venv
+	.lock-venv/bin/pip install --quiet maturin -e '.[test]'
+	{ sed -n '/^#/p' requirements/lock.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v '^hexadyn'; } > requirements/lock.txt.new
+	.lock-venv/bin/pip install --quiet -c requirements/lock.txt.new ray
+	{ sed -n '/^#/p' requirements/ray-lock.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v '^hexadyn'; } > requirements/ray-lock.txt.new
+	mv requirements/lock.txt.new requirements/lock.txt
+	mv requirements/ray-lock.txt.new requirements/ray-lock.txt
+	rm -rf .lock-venv
+
+clean:
+	rm -rf $(VENV) target

@@ -1,0 +1,31 @@
+"""hexadyn: multiphysics dynamics and gait control of six-legged walking robots.
+
+The numerics live in the Rust engine (``hexadyn._core``); this package is the user's front.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from hexadyn._core import __version__
+
+__all__ = ["__version__", "DEFAULT_ROBOT", "default_robot_path"]
+
+#: Name of the default robot description (the AMRU5 of the thesis).
+DEFAULT_ROBOT = "amru5"
+
+
+def default_robot_path() -> Path | None:
+    """Path of the default robot description file, or None while the package ships none.
+
+    The engine is asked first (``_core.default_robot_path``, once the bindings expose it); then
+    the package data ``hexadyn/robots/amru5.toml`` is looked for.
+    """
+    from hexadyn import _core
+
+    from_engine = getattr(_core, "default_robot_path", None)
+    if callable(from_engine):
+        path = from_engine()
+        return Path(path) if path else None
+    packaged = Path(__file__).resolve().parent / "robots" / f"{DEFAULT_ROBOT}.toml"
+    return packaged if packaged.is_file() else None
