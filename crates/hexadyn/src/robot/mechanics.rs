@@ -178,3 +178,105 @@ impl Mechanics {
         })
     }
 }
+
+impl MechanicsParameters {
+    /// The mechanics of a robot description (SI units). Interpretations of the lost figures
+    /// (NOTES.md), kept here in one place:
+    /// - the q_r axis O_l lies at the height of the body centre of mass, at R_rot along the leg
+    ///   direction;
+    /// - the centre of gravity of link 0 lies at L_G0 from A along the link, that of the leg
+    ///   (link 3) at x_G_leg from C; links 1 and 2 have theirs at mid-length;
+    /// - all three rotors ride on the leg chassis (Eq. 3.69-3.71), the q_r rotor at L_x6 from
+    ///   the body centre along the leg direction.
+    pub fn from_description(d: &super::RobotDescription) -> Self {
+        let g = &d.geometry;
+        let pg = &g.pantograph;
+        let inertia = |b: &super::description::RigidBody| Inertia { mass: b.mass_kg, moments: Vector3::from(b.principal_moments()) };
+        let i = &d.inertia;
+        MechanicsParameters {
+            pantograph: PantographGeometry { l0: pg.l_0_m, l1: pg.l_1_m, l2: pg.l_2_m, l3: pg.l_3_m, c: pg.c_m },
+            leg_angles: d.leg_angles_rad(),
+            r_rot: g.body.r_rot_m,
+            chassis_cog: Vector3::new(g.chassis.l_x1_m, g.chassis.l_y1_m, g.chassis.l_z1_m),
+            crossing_point: Vector3::new(g.chassis.l_xc_m, g.chassis.l_yc_m, g.chassis.l_zc_m),
+            link_cog: [pg.l_g0_m, pg.l_1_m / 2.0, pg.l_2_m / 2.0, pg.x_g_leg_m],
+            rotor_r_radius: g.actuators.l_x6_m,
+            rotor_v: Vector3::new(g.actuators.l_x7_m, g.actuators.l_y7_m, g.actuators.l_z7_m),
+            rotor_h: Vector3::new(g.actuators.l_x8_m, g.actuators.l_y8_m, g.actuators.l_z8_m),
+            reductions: [d.reductions.n_r, d.reductions.n_v_rad_per_m, d.reductions.n_h_rad_per_m],
+            body: inertia(&i.main_body),
+            chassis: inertia(&i.chassis),
+            links: [inertia(&i.pantograph_upper), inertia(&i.pantograph_left), inertia(&i.pantograph_lower), inertia(&i.pantograph_leg)],
+            rotor_mass: i.rotor.mass_kg,
+            rotor_axial: i.rotor.i_axial_kg_m2,
+            rotor_equatorial: i.rotor.i_equatorial_kg_m2,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mbs::{kinematics, mass_matrix, Data};
+    use crate::robot::RobotDescription;
+    use crate::spatial::{rotation_about, Htm};
+    use approx::assert_relative_eq;
+    use nalgebra::DMatrix;
+
+    fn amru5() -> Mechanics {
+        Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap()
+    }
+
+    /// 49 bodies, 24 DOF (Section 3.4) and the total mass of Table B.2.
+    #[test]
+    fn counts_and_mass() {
+        let m = amru5();
+        assert_eq!(m.model.body_count(), 49);
+        assert_eq!(m.model.coordinate_count(), 24);
+        assert_relative_eq!(m.model.total_mass(), 34.447, epsilon = 1e-9);
+    }
+
+    /// The foot of the multibody model sits where the planar linkage puts it, in the leg plane
+    /// through C*, for any body pose and q_r.
+    #[test]
+    fn foot_matches_the_planar_linkage() {
+        let mech = amru5();
+        let p = &mech.parameters;
+        let mut data = Data::new(&mech.model);
+        let mut q = vec![0.0; DOF];
+        q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
+        for leg in 0..6 {
+            q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
+            q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
+            q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
+        }
+        kinematics(&mech.model, &mut data, &q, &vec![0.0; DOF]);
+        let body = Htm { rotation: crate::spatial::yaw_pitch_roll(q[3], q[4], q[5]), translation: Vector3::new(q[0], q[1], q[2]) };
+        for (leg, bodies) in mech.legs.iter().enumerate() {
+            let (qr, qv, qh) = (q[joint_index(leg, 0)], q[joint_index(leg, 1)], q[joint_index(leg, 2)]);
+            let f = p.pantograph.foot(qv, qh);
+            let c_star = p.chassis_cog + p.crossing_point;
+            let in_leg = rotation_about(&Vector3::z(), -qr) * (c_star + Vector3::new(f.x, 0.0, f.y));
+            let expected = body.apply(&(rotation_about(&Vector3::z(), p.leg_angles[leg]) * (Vector3::new(p.r_rot, 0.0, 0.0) + in_leg)));
+            assert_relative_eq!(data.point(bodies.links[3], &mech.foot_local), expected, epsilon = 1e-12);
+        }
+    }
+
+    /// The rotors dominate the joint inertia: M_vv ≈ n_v² I_a (Section 4.4.1, τ_m ≈ 5.8 ms).
+    #[test]
+    fn reflected_rotor_inertia_dominates_the_joint_mass() {
+        let mech = amru5();
+        let mut data = Data::new(&mech.model);
+        let mut q = vec![0.0; DOF];
+        for leg in 0..6 {
+            q[joint_index(leg, 1)] = 0.06;
+            q[joint_index(leg, 2)] = 0.04;
+        }
+        kinematics(&mech.model, &mut data, &q, &vec![0.0; DOF]);
+        let mut m = DMatrix::zeros(DOF, DOF);
+        mass_matrix(&mech.model, &data, &mut m);
+        let p = &mech.parameters;
+        let mvv = m[(joint_index(0, 1), joint_index(0, 1))];
+        assert_relative_eq!(mvv, p.reductions[1].powi(2) * p.rotor_axial, max_relative = 1e-3);
+    }
+}

@@ -180,6 +180,12 @@ impl Newmark {
     /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15): on return `state().t == t_end`.
     /// Inputs are held constant.
     pub fn advance_to<S: System + ?Sized>(&mut self, sys: &mut S, t_end: f64) -> Result<(), SimError> {
+        self.advance_to_observed(sys, t_end, |_, _| {})
+    }
+
+    /// [`Self::advance_to`], calling `observe(sys, state)` after every accepted step (to integrate
+    /// powers into energies, record fine-grained outputs, ...).
+    pub fn advance_to_observed<S: System + ?Sized>(&mut self, sys: &mut S, t_end: f64, mut observe: impl FnMut(&mut S, &State)) -> Result<(), SimError> {
         if t_end < self.state.t {
             return Err(SimError::Backwards { requested: t_end, current: self.state.t });
         }
@@ -199,6 +205,7 @@ impl Newmark {
                     if lands {
                         self.state.t = t_end;
                     }
+                    observe(sys, &self.state);
                 }
                 StepOutcome::Rejected { h_next } => {
                     if h_next < self.options.h_min {
