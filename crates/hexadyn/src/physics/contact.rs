@@ -75,7 +75,7 @@ impl Default for GroundContact {
 }
 
 /// The force of the ground on the foot and its exact Jacobians.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactForce {
     /// F = F_n n + F_t (N).
     pub force: Vector3<f64>,

@@ -17,6 +17,7 @@
 
 pub mod description;
 pub mod mechanics;
+pub mod model;
 pub mod pantograph;
 
 pub use description::{

@@ -1,0 +1,367 @@
+//! The complete robot model as one residual system (thesis Section 3.5, Fig. 3.16, Table 3.5):
+//! the 24-DOF multibody mechanics, ground contact at the six feet, joint friction (none,
+//! dry/viscous or LuGre with its 18 bristle states) and the 18 DC motors with their H-bridge
+//! (inductance neglected, Eq. 4.4, or kept as 18 current states, Eq. 3.91).
+//!
+//! Rows and coordinates: q (24, Eq. 3.51), then the bristle states z = q'_z (Eq. 3.85), then the
+//! motor currents i = q'_i (Eq. 3.91) when they are states. Inputs: the 18 voltages commanded by
+//! the controllers, held between control instants, saturated at the supply voltage and cut by
+//! the limit switches at the ends of the joint strokes (Section 2.3.1).
+
+use std::ops::RangeInclusive;
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+
+use super::description::RobotDescription;
+use super::mechanics::{joint_index, Mechanics, MechanicsParameters, DOF};
+use super::Joint;
+use crate::mbs::{self, Data};
+use crate::physics::{ContactForce, GroundContact, Terrain};
+use crate::physics::{DryViscous, FrictionElement, JointFriction, LoadDependence, LuGre, SteadyState};
+use crate::physics::{limit_switch, saturate, DcMotor};
+use crate::sim::{Jacobian, Layout, Order, System};
+
+/// Number of actuated joints.
+pub const JOINTS: usize = 18;
+
+/// Joint friction model of a simulation (Section 6.1: the three cases compared in Chapter 6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrictionModel {
+    None,
+    DryViscous,
+    LuGre,
+}
+
+/// The modelling choices of a simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelOptions {
+    pub friction: FrictionModel,
+    /// Load-dependent dry friction of the horizontal joints (Eq. 5.12, Section 6.4.4).
+    pub load_dependence: bool,
+    /// Keep the motor inductance and the currents as states (Eq. 3.91) instead of Eq. 4.4.
+    pub inductance: bool,
+    /// Ground contact parameters (Table 3.3 unless overridden).
+    pub ground: GroundContact,
+    /// Supply voltage at the H-bridges (V).
+    pub supply_voltage: f64,
+}
+
+impl ModelOptions {
+    /// The description's ground, supply and the given friction model; no inductance (Section 4.5).
+    pub fn from_description(d: &RobotDescription, friction: FrictionModel) -> Self {
+        let g = &d.ground;
+        ModelOptions {
+            friction,
+            load_dependence: false,
+            inductance: false,
+            ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s },
+            supply_voltage: d.driver.supply_voltage_v,
+        }
+    }
+}
+
+/// The immutable robot model: mechanics, motors, friction elements, contact and terrain.
+#[derive(Clone)]
+pub struct RobotModel {
+    pub mechanics: Mechanics,
+    /// Per joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+    pub motors: [DcMotor; JOINTS],
+    pub friction: [FrictionElement; JOINTS],
+    /// Joint strokes (limit switches), per joint type.
+    pub strokes: [RangeInclusive<f64>; 3],
+    pub options: ModelOptions,
+    pub terrain: Arc<dyn Terrain + Send + Sync>,
+    layout: Layout,
+    bristles: Option<usize>,
+    currents: Option<usize>,
+}
+
+fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
+    let p = d.friction(leg, joint);
+    let law = match options.friction {
+        FrictionModel::None => JointFriction::None,
+        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus, f_v_pos: p.f_v_plus, f_v_neg: p.f_v_minus, epsilon: p.epsilon }),
+        FrictionModel::LuGre => {
+            // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
+            // (horizontal, viscous effects neglected).
+            let (steady, f_v_pos, f_v_neg) = match (joint, p.q_st) {
+                (Joint::Vertical, Some(qd_st)) => (
+                    SteadyState::Stribeck { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus, tau_s_pos: p.tau_f_s_plus, tau_s_neg: p.tau_f_s_minus, qd_st },
+                    p.f_v_plus,
+                    p.f_v_minus,
+                ),
+                (Joint::Horizontal, _) => (SteadyState::Dry { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus }, 0.0, 0.0),
+                _ => (SteadyState::Dry { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus }, p.f_v_plus, p.f_v_minus),
+            };
+            JointFriction::LuGre(LuGre { sigma_0: p.sigma_0, sigma_1: p.sigma_1, v_d: p.v_d, f_v_pos, f_v_neg, steady })
+        }
+    };
+    let element = FrictionElement::new(law);
+    match (options.load_dependence, options.friction, p.load_dependence) {
+        (true, FrictionModel::DryViscous | FrictionModel::LuGre, Some(c)) => element.with_load(LoadDependence { a2_pos: c.a_2_plus, a1_pos: c.a_1_plus, a2_neg: c.a_2_minus, a1_neg: c.a_1_minus }),
+        _ => element,
+    }
+}
+
+impl RobotModel {
+    pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain + Send + Sync>) -> Self {
+        let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
+        let motor = |joint: Joint| DcMotor {
+            r: d.motor.resistance_ohm,
+            r_bridge: d.driver.series_resistance_ohm(),
+            l: d.motor.inductance_h(),
+            k_t: d.motor.torque_constant_nm_per_a,
+            n: d.reduction(joint),
+            inductance: options.inductance,
+        };
+        let motors = std::array::from_fn(|k| motor(Joint::ALL[k % 3]));
+        let friction = std::array::from_fn(|k| friction_element(d, k / 3, Joint::ALL[k % 3], &options));
+        let strokes = Joint::ALL.map(|j| {
+            let (lo, hi) = d.joint_range(j);
+            lo..=hi
+        });
+
+        let mut layout = Layout::default();
+        let names = ["X", "Y", "Z", "yaw", "pitch", "roll"];
+        for (i, name) in names.iter().enumerate() {
+            layout.push(*name, Order::Second, if i < 3 { 1e-6 } else { 1e-5 }, "multibody (main body)");
+        }
+        let joint_name = |k: usize| format!("{}[{}]", Joint::ALL[k % 3].symbol(), k / 3);
+        for k in 0..JOINTS {
+            let scale = if k % 3 == 0 { 1e-5 } else { 1e-7 };
+            layout.push(joint_name(k), Order::Second, scale, format!("multibody (leg {})", k / 3));
+        }
+        let bristles = (options.friction == FrictionModel::LuGre).then(|| {
+            let first = layout.len();
+            for k in 0..JOINTS {
+                layout.push(format!("z_{}", joint_name(k)), Order::First, 1e-10, format!("LuGre bristle {}", joint_name(k)));
+            }
+            first
+        });
+        let currents = options.inductance.then(|| {
+            let first = layout.len();
+            for k in 0..JOINTS {
+                layout.push(format!("i_{}", joint_name(k)), Order::First, 1e-3, format!("motor {}", joint_name(k)));
+            }
+            first
+        });
+        RobotModel { mechanics, motors, friction, strokes, options, terrain, layout, bristles, currents }
+    }
+
+    /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance
+    /// (42 for the model of Section 4.5).
+    pub fn coordinate_count(&self) -> usize {
+        self.layout.len()
+    }
+    /// Index of the bristle state of joint k, if any.
+    pub fn bristle_index(&self, k: usize) -> Option<usize> {
+        self.bristles.map(|b| b + k)
+    }
+    /// Index of the current state of joint k, if any.
+    pub fn current_index(&self, k: usize) -> Option<usize> {
+        self.currents.map(|c| c + k)
+    }
+
+    /// Initial q for the given joint positions: level body at (0, 0, Z), Z chosen so that the
+    /// lowest foot just touches the terrain; all other states zero.
+    pub fn touching_ground(&self, joints: &[f64; JOINTS]) -> Vec<f64> {
+        let mut q = vec![0.0; self.coordinate_count()];
+        q[6..DOF].copy_from_slice(joints);
+        let mech = &self.mechanics;
+        let mut data = Data::new(&mech.model);
+        mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
+        let clearance = mech
+            .legs
+            .iter()
+            .map(|b| {
+                let p = data.point(b.links[3], &mech.foot_local);
+                p.z - self.terrain.height_normal(p.x, p.y).0
+            })
+            .fold(f64::INFINITY, f64::min);
+        q[2] = -clearance;
+        q
+    }
+
+    /// Coordinates that a static equilibrium of the standing robot must lock: the horizontal
+    /// position and the yaw of the body (the ground friction of Eq. 3.73 has no stiffness), the
+    /// joints (Section 6.2 locks them all) and every bristle and current state.
+    pub fn standing_locks(&self) -> Vec<usize> {
+        [0, 1, 3].into_iter().chain(6..self.coordinate_count()).collect()
+    }
+}
+
+/// What the model computed at the last evaluation, per joint and per foot.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Outputs {
+    /// Voltage across the motor and H-bridge after saturation and limit switches (V).
+    pub voltage: [f64; JOINTS],
+    /// Motor current (A).
+    pub current: [f64; JOINTS],
+    /// Joint torque of the motor n k_t i (Nm or N).
+    pub motor_torque: [f64; JOINTS],
+    /// Friction torque τ_f opposing the motion (Nm or N).
+    pub friction_torque: [f64; JOINTS],
+    /// Bristle deflection z (rad or m); zero without LuGre.
+    pub bristle: [f64; JOINTS],
+    /// Ground force on each foot (N, global frame).
+    pub contact: [ContactForce; 6],
+    /// Foot positions (m, global frame).
+    pub foot: [Vector3<f64>; 6],
+}
+
+/// The robot as a [`System`]: model, multibody workspace and held inputs.
+#[derive(Clone)]
+pub struct Robot {
+    pub model: Arc<RobotModel>,
+    pub data: Data,
+    /// Commanded motor voltages (inputs, V).
+    pub voltages: [f64; JOINTS],
+    pub outputs: Outputs,
+}
+
+impl Robot {
+    pub fn new(model: Arc<RobotModel>) -> Self {
+        let data = Data::new(&model.mechanics.model);
+        Robot { model, data, voltages: [0.0; JOINTS], outputs: Outputs::default() }
+    }
+
+    /// Kinematics, contact forces and joint torques at (q, q', q''), written into the multibody
+    /// workspace and [`Self::outputs`].
+    pub fn evaluate(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) {
+        let m = &*self.model;
+        let mech = &m.mechanics;
+        mbs::kinematics(&mech.model, &mut self.data, &q[..DOF], &qd[..DOF]);
+        self.data.clear_forces();
+        let out = &mut self.outputs;
+        // Ground contact at the feet (Eq. 3.72-3.73).
+        for (leg, bodies) in mech.legs.iter().enumerate() {
+            let p = self.data.point(bodies.links[3], &mech.foot_local);
+            let v = self.data.point_velocity(bodies.links[3], &p);
+            let c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            if c.force != Vector3::zeros() {
+                self.data.add_force(bodies.links[3], &p, &c.force);
+            }
+            out.contact[leg] = c;
+            out.foot[leg] = p;
+        }
+        // Motors (Eq. 3.90-3.92 or 4.4-4.7) and joint friction (Eq. 6.1 or 3.87).
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            let motor = &m.motors[k];
+            let u = limit_switch(saturate(self.voltages[k], m.options.supply_voltage), q[j], &m.strokes[k % 3]);
+            let i = match m.currents {
+                Some(c) => qd[c + k],
+                None => motor.current(qd[j], u).i,
+            };
+            let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
+            let load = out.contact[k / 3].normal_force;
+            let tau_f = m.friction[k].torque(qd[j], z, zdot, load).tau;
+            let tau_m = motor.joint_torque(i).0;
+            self.data.add_generalized_force(j, tau_m - tau_f);
+            out.voltage[k] = u;
+            out.current[k] = i;
+            out.motor_torque[k] = tau_m;
+            out.friction_torque[k] = tau_f;
+            out.bristle[k] = z;
+        }
+    }
+
+    fn write_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        self.evaluate(q, qd, qdd);
+        let m = &*self.model;
+        mbs::residual(&m.mechanics.model, &self.data, &qdd[..DOF], &mut f[..DOF]);
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            if let Some(b) = m.bristles {
+                let load = self.outputs.contact[k / 3].normal_force;
+                f[b + k] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).map_or(0.0, |r| r.f);
+            }
+            if let Some(c) = m.currents {
+                f[c + k] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).f;
+            }
+        }
+    }
+}
+
+impl System for Robot {
+    fn layout(&self) -> &Layout {
+        &self.model.layout
+    }
+
+    fn residual(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        self.write_residual(q, qd, qdd, f);
+    }
+
+    /// Exact blocks for the columns of the bristle and current states and the mass matrix
+    /// (Eq. 3.39); the columns of q and q' of the multibody coordinates by central differences
+    /// of the whole residual (contact, inertia and joint forces depend on them through the
+    /// kinematics).
+    fn jacobian(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], jac: &mut Jacobian) -> bool {
+        let n = q.len();
+        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+        let (mut x, mut xd) = (q.to_vec(), qd.to_vec());
+        let scales = self.model.layout.scales.clone();
+        for j in 0..DOF {
+            let step = 1e-6 * x[j].abs().max(1e3 * scales[j]);
+            x[j] = q[j] + step;
+            self.write_residual(&x, qd, qdd, &mut fp);
+            x[j] = q[j] - step;
+            self.write_residual(&x, qd, qdd, &mut fm);
+            x[j] = q[j];
+            for i in 0..n {
+                jac.kt[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+            }
+            let step = 1e-6 * xd[j].abs().max(1e2 * scales[j]);
+            xd[j] = qd[j] + step;
+            self.write_residual(q, &xd, qdd, &mut fp);
+            xd[j] = qd[j] - step;
+            self.write_residual(q, &xd, qdd, &mut fm);
+            xd[j] = qd[j];
+            for i in 0..n {
+                jac.ct[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+            }
+        }
+        self.evaluate(q, qd, qdd);
+        let m = &*self.model;
+        mbs::mass_matrix(&m.mechanics.model, &self.data, &mut jac.m);
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            let load = self.outputs.contact[k / 3].normal_force;
+            if let Some(b) = m.bristles {
+                let (z, zdot) = (qd[b + k], qdd[b + k]);
+                // f_j contains +τ_f (the joint force is τ_m − τ_f).
+                let t = m.friction[k].torque(qd[j], z, zdot, load);
+                jac.m[(j, b + k)] = t.dtau_dzdot;
+                jac.ct[(j, b + k)] = t.dtau_dz;
+                let r = m.friction[k].bristle_residual(qd[j], z, zdot, load).expect("LuGre has a bristle state");
+                jac.m[(b + k, b + k)] = r.df_dzdot;
+                jac.ct[(b + k, b + k)] = r.df_dz;
+            }
+            if let Some(c) = m.currents {
+                let r = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]);
+                jac.m[(c + k, c + k)] = r.df_ddi;
+                jac.ct[(c + k, c + k)] = r.df_di;
+                // f_j contains −τ_m = −n k_t i.
+                jac.ct[(j, c + k)] = -m.motors[k].joint_torque(1.0).1;
+            }
+        }
+        true
+    }
+
+    fn input_count(&self) -> usize {
+        JOINTS
+    }
+    fn input(&self, k: usize) -> f64 {
+        self.voltages[k]
+    }
+    fn set_input(&mut self, k: usize, value: f64) {
+        self.voltages[k] = value;
+    }
+}
+
+/// Index in q of joint k (k = 3 leg + joint type).
+pub const fn joint_coordinate(k: usize) -> usize {
+    joint_index(k / 3, k % 3)
+}
