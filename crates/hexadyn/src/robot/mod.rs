@@ -19,6 +19,7 @@ pub mod description;
 pub mod mechanics;
 pub mod model;
 pub mod pantograph;
+pub mod simulation;
 
 pub use description::{
     DescriptionError, FieldError, Gaussian, JointFriction, LoadCoefficients, LoadDependenceDistribution,

@@ -22,8 +22,7 @@ use crate::physics::{DryViscous, FrictionElement, JointFriction, LoadDependence,
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::sim::{Jacobian, Layout, Order, System};
 
-/// Number of actuated joints.
-pub const JOINTS: usize = 18;
+pub use crate::control::JOINTS;
 
 /// Joint friction model of a simulation (Section 6.1: the three cases compared in Chapter 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -143,7 +142,7 @@ impl RobotModel {
         let currents = options.inductance.then(|| {
             let first = layout.len();
             for k in 0..JOINTS {
-                layout.push(format!("i_{}", joint_name(k)), Order::First, 1e-3, format!("motor {}", joint_name(k)));
+                layout.push(format!("i_{}", joint_name(k)), Order::First, 1e-5, format!("motor {}", joint_name(k)));
             }
             first
         });

@@ -1,0 +1,59 @@
+//! The controller interface (thesis Section 2.3.2 and architecture principle 3): every control
+//! period the controller receives what the real robot measures — encoder positions, motor
+//! currents, the supply voltage — plus the body pose when a navigation system is present, and
+//! returns the 18 motor voltages. A [`Plant`] is what is driven: the simulated robot, or the real
+//! robot's slave boards through the master/slave link.
+
+use nalgebra::Vector3;
+
+/// Number of actuated joints of a hexapod with 3-DOF legs.
+pub const JOINTS: usize = 18;
+
+/// Body pose from a navigation system (Section 7.4), yaw-pitch-roll as in Eq. 3.52.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyPose {
+    pub position: Vector3<f64>,
+    pub yaw: f64,
+    pub pitch: f64,
+    pub roll: f64,
+}
+
+/// What the controller receives at a control instant.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Measurements {
+    pub t: f64,
+    /// Joint positions as the encoders report them (q_r in rad, q_v and q_h in m), per joint
+    /// k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+    pub positions: [f64; JOINTS],
+    /// Motor currents (A).
+    pub currents: [f64; JOINTS],
+    /// Supply voltage of the H-bridges (V).
+    pub supply_voltage: f64,
+    /// True body pose, when the scenario has a navigation system.
+    pub pose: Option<BodyPose>,
+}
+
+/// What the controller returns: the motor voltages and, for the record, the joint references
+/// it tracks.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Command {
+    pub voltages: [f64; JOINTS],
+    pub references: [f64; JOINTS],
+}
+
+/// A controller run at the control period with zero-order-hold outputs.
+pub trait Controller {
+    fn update(&mut self, m: &Measurements) -> Command;
+}
+
+/// What a controller drives, one control period at a time.
+pub trait Plant {
+    type Error: std::error::Error;
+    /// Control period Δt (s).
+    fn period(&self) -> f64;
+    fn measure(&mut self) -> Measurements;
+    /// Applies the voltages for the next period (zero-order hold).
+    fn actuate(&mut self, voltages: &[f64; JOINTS]);
+    /// Lets one control period pass.
+    fn wait_period(&mut self) -> Result<(), Self::Error>;
+}

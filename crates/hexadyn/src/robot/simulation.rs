@@ -1,0 +1,226 @@
+//! The simulated robot as a [`Plant`]: the robot model integrated by Newmark between control
+//! instants, encoders quantizing the joint positions, and an energy account integrated at every
+//! accepted step (electrical input, Joule, friction and contact losses, stored energies).
+
+use std::sync::Arc;
+
+use super::model::{Robot, RobotModel};
+use super::RobotDescription;
+use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant, JOINTS};
+use crate::mbs;
+use crate::physics::JointFriction;
+use crate::sim::{Newmark, NewmarkOptions, SimError, State};
+
+/// Energies (J) accumulated since the start, by trapezoidal integration of the powers at the
+/// accepted integration steps, and the stored energies at the current state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EnergyAccount {
+    /// ∫ u i dt per joint (electrical energy drawn, Eq. 6.7).
+    pub electrical: [f64; JOINTS],
+    /// ∫ (R + R_bridge) i² dt per joint.
+    pub joule: [f64; JOINTS],
+    /// ∫ τ_f q' dt per joint: work done against friction (including the energy momentarily
+    /// stored in the LuGre bristles, see `bristle_energy`).
+    pub friction_work: [f64; JOINTS],
+    /// ∫ τ_m q' dt per joint: mechanical work of the motor on its joint.
+    pub motor_work: [f64; JOINTS],
+    /// ∫ −F·v dt per foot: work done by the feet on the ground (including the elastic energy
+    /// stored in the ground, see `contact_energy`).
+    pub contact_work: [f64; 6],
+    /// Stored energies at the current state: kinetic, potential (gravity), bristles ½ σ0 z²,
+    /// ground ∫ K δ^p_K dδ, inductances ½ L i².
+    pub kinetic: f64,
+    pub potential: f64,
+    pub bristle_energy: f64,
+    pub contact_energy: f64,
+    pub magnetic_energy: f64,
+    powers: Option<Powers>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct Powers {
+    t: f64,
+    electrical: [f64; JOINTS],
+    joule: [f64; JOINTS],
+    friction: [f64; JOINTS],
+    motor: [f64; JOINTS],
+    contact: [f64; 6],
+}
+
+impl EnergyAccount {
+    /// Adds the powers of the state the robot outputs were just evaluated at.
+    fn accumulate(&mut self, robot: &Robot, state: &State) {
+        let m = &*robot.model;
+        let out = &robot.outputs;
+        let qd = state.qd.as_slice();
+        let mut p = Powers { t: state.t, electrical: [0.0; JOINTS], joule: [0.0; JOINTS], friction: [0.0; JOINTS], motor: [0.0; JOINTS], contact: [0.0; 6] };
+        self.bristle_energy = 0.0;
+        self.magnetic_energy = 0.0;
+        for k in 0..JOINTS {
+            let v = qd[6 + k];
+            let motor = &m.motors[k];
+            p.electrical[k] = motor.electrical_power(out.voltage[k], out.current[k]);
+            p.joule[k] = motor.joule_loss(out.current[k]);
+            p.friction[k] = out.friction_torque[k] * v;
+            p.motor[k] = out.motor_torque[k] * v;
+            if let JointFriction::LuGre(law) = &m.friction[k].law {
+                self.bristle_energy += 0.5 * law.sigma_0 * out.bristle[k].powi(2);
+            }
+            if motor.inductance {
+                self.magnetic_energy += 0.5 * motor.l * out.current[k].powi(2);
+            }
+        }
+        for (leg, c) in out.contact.iter().enumerate() {
+            p.contact[leg] = c.absorbed_power;
+        }
+        self.contact_energy = out.contact.iter().map(|c| c.elastic_energy).sum();
+        self.kinetic = mbs::kinetic_energy(&m.mechanics.model, &robot.data);
+        self.potential = mbs::potential_energy(&m.mechanics.model, &robot.data);
+        if let Some(prev) = &self.powers {
+            let h = 0.5 * (p.t - prev.t);
+            for k in 0..JOINTS {
+                self.electrical[k] += h * (prev.electrical[k] + p.electrical[k]);
+                self.joule[k] += h * (prev.joule[k] + p.joule[k]);
+                self.friction_work[k] += h * (prev.friction[k] + p.friction[k]);
+                self.motor_work[k] += h * (prev.motor[k] + p.motor[k]);
+            }
+            for leg in 0..6 {
+                self.contact_work[leg] += h * (prev.contact[leg] + p.contact[leg]);
+            }
+        }
+        self.powers = Some(p);
+    }
+
+    /// Electrical energy in minus everything it should have become: Δ(kinetic + potential) +
+    /// Joule + friction work + contact work + Δ(magnetic energy). Zero up to integration error.
+    pub fn balance_error(&self, initial: &EnergyAccount) -> f64 {
+        let sum = |a: &[f64]| a.iter().sum::<f64>();
+        sum(&self.electrical)
+            - (self.kinetic - initial.kinetic + self.potential - initial.potential)
+            - sum(&self.joule)
+            - sum(&self.friction_work)
+            - sum(&self.contact_work)
+            - (self.magnetic_energy - initial.magnetic_energy)
+    }
+}
+
+/// Options of the simulated plant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlantOptions {
+    pub integrator: NewmarkOptions,
+    /// Control period Δt (s), 10 ms on AMRU5.
+    pub period: f64,
+    /// Encoder impulses per motor revolution.
+    pub encoder_counts: u32,
+    /// Whether the controller receives the true body pose (navigation system, Section 7.4).
+    pub navigation: bool,
+}
+
+impl PlantOptions {
+    pub fn from_description(d: &RobotDescription) -> Self {
+        PlantOptions {
+            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, ..Default::default() },
+            period: d.controller.period_s,
+            encoder_counts: d.controller.encoder_impulses_per_rev,
+            navigation: false,
+        }
+    }
+}
+
+/// The simulated robot driven like the real one.
+pub struct SimulatedRobot {
+    pub robot: Robot,
+    pub integrator: Newmark,
+    pub energy: EnergyAccount,
+    /// The energy account at the start, for balances.
+    pub initial_energy: EnergyAccount,
+    encoders: [Encoder; JOINTS],
+    period: f64,
+    navigation: bool,
+}
+
+impl SimulatedRobot {
+    /// Starts from (q, q'); accelerations are made consistent.
+    pub fn new(model: Arc<RobotModel>, q: &[f64], qd: &[f64], options: &PlantOptions) -> Result<Self, SimError> {
+        let mut robot = Robot::new(model);
+        let integrator = Newmark::new(&mut robot, 0.0, q, qd, options.integrator.clone())?;
+        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: options.encoder_counts, n: robot.model.motors[k].n });
+        let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), encoders, period: options.period, navigation: options.navigation };
+        plant.observe();
+        plant.initial_energy = plant.energy.clone();
+        Ok(plant)
+    }
+
+    pub fn state(&self) -> &State {
+        self.integrator.state()
+    }
+
+    /// Re-evaluates the outputs at the current state and accumulates the energies.
+    fn observe(&mut self) {
+        let s = self.integrator.state();
+        self.robot.evaluate(s.q.as_slice(), s.qd.as_slice(), s.qdd.as_slice());
+        self.energy.accumulate(&self.robot, s);
+    }
+}
+
+impl Plant for SimulatedRobot {
+    type Error = SimError;
+
+    fn period(&self) -> f64 {
+        self.period
+    }
+
+    fn measure(&mut self) -> Measurements {
+        let s = self.integrator.state();
+        let q = s.q.as_slice();
+        Measurements {
+            t: s.t,
+            positions: std::array::from_fn(|k| self.encoders[k].measure(q[6 + k])),
+            currents: self.robot.outputs.current,
+            supply_voltage: self.robot.model.options.supply_voltage,
+            pose: self.navigation.then(|| BodyPose { position: nalgebra::Vector3::new(q[0], q[1], q[2]), yaw: q[3], pitch: q[4], roll: q[5] }),
+        }
+    }
+
+    fn actuate(&mut self, voltages: &[f64; JOINTS]) {
+        self.robot.voltages = *voltages;
+    }
+
+    fn wait_period(&mut self) -> Result<(), SimError> {
+        // The voltages jumped at this instant: make q'' consistent before stepping on, and start
+        // the power integration of the period from the powers under the new voltages.
+        self.integrator.reset_accelerations(&mut self.robot)?;
+        self.observe();
+        let t_end = self.integrator.state().t + self.period;
+        let energy = &mut self.energy;
+        self.integrator.advance_to_observed(&mut self.robot, t_end, |robot, state| {
+            robot.evaluate(state.q.as_slice(), state.qd.as_slice(), state.qdd.as_slice());
+            energy.accumulate(robot, state);
+        })?;
+        // The last accepted step landed on t_end: the outputs are those of the current state.
+        Ok(())
+    }
+}
+
+/// Runs `controller` on `plant` for `duration` seconds: at every control instant, measure,
+/// compute the command, hand it to `record`, apply it and let one period pass. `record` sees
+/// the plant, the measurements and the command at each instant, the last one included.
+pub fn run<P: Plant, C: Controller + ?Sized>(
+    plant: &mut P,
+    controller: &mut C,
+    duration: f64,
+    mut record: impl FnMut(&P, &Measurements, &Command),
+) -> Result<(), P::Error> {
+    let periods = (duration / plant.period()).round() as usize;
+    for i in 0..=periods {
+        let m = plant.measure();
+        let command = controller.update(&m);
+        record(plant, &m, &command);
+        if i == periods {
+            break;
+        }
+        plant.actuate(&command.voltages);
+        plant.wait_period()?;
+    }
+    Ok(())
+}
