@@ -11,7 +11,7 @@
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
 
 use super::description::RobotDescription;
 use super::mechanics::{joint_index, Mechanics, MechanicsParameters, DOF};
@@ -284,6 +284,26 @@ impl Robot {
     }
 }
 
+impl Robot {
+    /// M = ∂f/∂q'' (Eq. 3.39 for the multibody rows, plus the bristle and inductance terms) at
+    /// the state of the last [`Robot::evaluate`].
+    fn write_mass_matrix(&self, qd: &[f64], qdd: &[f64], mass: &mut DMatrix<f64>) {
+        let m = &*self.model;
+        mbs::mass_matrix(&m.mechanics.model, &self.data, mass);
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            let load = self.outputs.contact[k / 3].normal_force;
+            if let Some(b) = m.bristles {
+                mass[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load).dtau_dzdot;
+                mass[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dzdot;
+            }
+            if let Some(c) = m.currents {
+                mass[(c + k, c + k)] = m.motors[k].l;
+            }
+        }
+    }
+}
+
 impl System for Robot {
     fn layout(&self) -> &Layout {
         &self.model.layout
@@ -323,29 +343,28 @@ impl System for Robot {
             }
         }
         self.evaluate(q, qd, qdd);
+        self.write_mass_matrix(qd, qdd, &mut jac.m);
         let m = &*self.model;
-        mbs::mass_matrix(&m.mechanics.model, &self.data, &mut jac.m);
         for k in 0..JOINTS {
             let j = 6 + k;
             let load = self.outputs.contact[k / 3].normal_force;
             if let Some(b) = m.bristles {
-                let (z, zdot) = (qd[b + k], qdd[b + k]);
                 // f_j contains +τ_f (the joint force is τ_m − τ_f).
-                let t = m.friction[k].torque(qd[j], z, zdot, load);
-                jac.m[(j, b + k)] = t.dtau_dzdot;
-                jac.ct[(j, b + k)] = t.dtau_dz;
-                let r = m.friction[k].bristle_residual(qd[j], z, zdot, load).expect("LuGre has a bristle state");
-                jac.m[(b + k, b + k)] = r.df_dzdot;
-                jac.ct[(b + k, b + k)] = r.df_dz;
+                jac.ct[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load).dtau_dz;
+                jac.ct[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dz;
             }
             if let Some(c) = m.currents {
-                let r = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]);
-                jac.m[(c + k, c + k)] = r.df_ddi;
-                jac.ct[(c + k, c + k)] = r.df_di;
+                jac.ct[(c + k, c + k)] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).df_di;
                 // f_j contains −τ_m = −n k_t i.
                 jac.ct[(j, c + k)] = -m.motors[k].joint_torque(1.0).1;
             }
         }
+        true
+    }
+
+    fn mass_matrix(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], m: &mut DMatrix<f64>) -> bool {
+        self.evaluate(q, qd, qdd);
+        self.write_mass_matrix(qd, qdd, m);
         true
     }
 

@@ -3,6 +3,7 @@
 use nalgebra::{DMatrix, DVector, LU};
 
 use super::error::largest_rows;
+use super::jacobian::mass_matrix;
 use super::{Jacobian, Order, SimError, System};
 
 /// Integration parameters. Defaults: the trapezoidal rule β = 1/4, γ = 1/2 (unconditionally
@@ -159,13 +160,16 @@ impl Newmark {
     /// rows) q'' is left as it is and the next Newmark step restores consistency.
     pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
         let t = self.state.t;
+        let m = mass_matrix(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
+        let lu = LU::new(m);
+        if !lu.is_invertible() {
+            return Ok(());
+        }
         for _ in 0..self.options.max_iterations {
             sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
             self.stats.residual_evaluations += 1;
             check_finite(sys, t, None, &self.work.f)?;
-            let jac = Jacobian::evaluate(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
-            self.stats.jacobian_evaluations += 1;
-            let Some(dx) = LU::new(jac.m.clone()).solve(&DVector::from_column_slice(&self.work.f)) else {
+            let Some(dx) = lu.solve(&DVector::from_column_slice(&self.work.f)) else {
                 return Ok(());
             };
             self.state.qdd -= &dx;
@@ -383,7 +387,7 @@ impl Newmark {
             let grow = (0.9 * ratio).clamp(0.2, 2.0);
             // Keep h (and the factorization) unless the change is worth a new LU.
             let proposed = (h * grow).clamp(o.h_min, o.h_max);
-            self.h = if proposed >= h && proposed <= 1.25 * self.h.max(h) { self.h.max(h) } else { proposed };
+            self.h = if proposed >= 0.9 * h && proposed <= 1.25 * self.h.max(h) { self.h.max(h) } else { proposed };
         } else {
             self.h = o.h_max;
         }

@@ -60,6 +60,13 @@ pub trait System {
         false
     }
 
+    /// Writes M = ∂f/∂q'' alone into `m` (zeroed by the caller) and returns true, when the
+    /// system can do it more cheaply than the whole Jacobian; false falls back to finite
+    /// differences on q''.
+    fn mass_matrix(&mut self, _t: f64, _q: &[f64], _qd: &[f64], _qdd: &[f64], _m: &mut nalgebra::DMatrix<f64>) -> bool {
+        false
+    }
+
     /// Number of inputs u (Eq. 3.16).
     fn input_count(&self) -> usize {
         0
