@@ -5,8 +5,8 @@
 //!
 //! Rows and coordinates: q (24, Eq. 3.51), then the bristle states z = q'_z (Eq. 3.85), then the
 //! motor currents i = q'_i (Eq. 3.91) when they are states. Inputs: the 18 voltages commanded by
-//! the controllers, held between control instants, saturated at the supply voltage and cut by
-//! the limit switches at the ends of the joint strokes (Section 2.3.1).
+//! the controllers, held between control instants (cut by the limit switches at the ends of the
+//! joint strokes, Section 2.3.1, see [`Robot::command`]) and saturated at the supply voltage.
 
 use std::ops::RangeInclusive;
 use std::sync::Arc;
@@ -215,7 +215,7 @@ pub struct Outputs {
 pub struct Robot {
     pub model: Arc<RobotModel>,
     pub data: Data,
-    /// Commanded motor voltages (inputs, V).
+    /// Motor voltages held over the control period (inputs, V).
     pub voltages: [f64; JOINTS],
     pub outputs: Outputs,
 }
@@ -224,6 +224,15 @@ impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
         Robot { model, data, voltages: [0.0; JOINTS], outputs: Outputs::default() }
+    }
+
+    /// Holds the commanded voltages for the next control period, cut by the limit switches of
+    /// the joints that are beyond their stroke and pushed further out (Section 2.3.1). The
+    /// switches are read at the control instant, as the slave boards apply the commands.
+    pub fn command(&mut self, commanded: &[f64; JOINTS], q: &[f64]) {
+        for k in 0..JOINTS {
+            self.voltages[k] = limit_switch(commanded[k], q[6 + k], &self.model.strokes[k % 3]);
+        }
     }
 
     /// Kinematics, contact forces and joint torques at (q, q', q''), written into the multibody
@@ -249,7 +258,7 @@ impl Robot {
         for k in 0..JOINTS {
             let j = 6 + k;
             let motor = &m.motors[k];
-            let u = limit_switch(saturate(self.voltages[k], m.options.supply_voltage), q[j], &m.strokes[k % 3]);
+            let u = saturate(self.voltages[k], m.options.supply_voltage);
             let i = match m.currents {
                 Some(c) => qd[c + k],
                 None => motor.current(qd[j], u).i,

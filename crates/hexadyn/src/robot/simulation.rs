@@ -119,7 +119,7 @@ pub struct PlantOptions {
 impl PlantOptions {
     pub fn from_description(d: &RobotDescription) -> Self {
         PlantOptions {
-            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, ..Default::default() },
+            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, slow_contraction: 0.9, ..Default::default() },
             period: d.controller.period_s,
             encoder_counts: d.controller.encoder_impulses_per_rev,
             navigation: false,
@@ -183,7 +183,8 @@ impl Plant for SimulatedRobot {
     }
 
     fn actuate(&mut self, voltages: &[f64; JOINTS]) {
-        self.robot.voltages = *voltages;
+        let q = self.integrator.state().q.clone();
+        self.robot.command(voltages, q.as_slice());
     }
 
     fn wait_period(&mut self) -> Result<(), SimError> {
