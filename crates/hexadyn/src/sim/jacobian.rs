@@ -66,26 +66,13 @@ pub fn finite_difference_jacobian<S: System + ?Sized>(sys: &mut S, t: f64, q: &[
     jac
 }
 
-/// M = ∂f/∂q'': from the system when it provides it, else by central differences on q''.
-pub fn mass_matrix<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> DMatrix<f64> {
+/// M = ∂f/∂q'': from the system when it provides it (`true` in the result), else the M block of
+/// [`Jacobian::evaluate`] (`false`).
+pub fn mass_matrix<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> (DMatrix<f64>, bool) {
     let n = q.len();
     let mut m = DMatrix::zeros(n, n);
     if sys.mass_matrix(t, q, qd, qdd, &mut m) {
-        return m;
+        return (m, true);
     }
-    let scales = sys.layout().scales.clone();
-    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    let mut x = qdd.to_vec();
-    for j in 0..n {
-        let step = 1e-6 * x[j].abs().max(scales[j]).max(1e-12);
-        x[j] = qdd[j] + step;
-        sys.residual(t, q, qd, &x, &mut fp);
-        x[j] = qdd[j] - step;
-        sys.residual(t, q, qd, &x, &mut fm);
-        x[j] = qdd[j];
-        for i in 0..n {
-            m[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
-        }
-    }
-    m
+    (Jacobian::evaluate(sys, t, q, qd, qdd).m, false)
 }

@@ -160,7 +160,10 @@ impl Newmark {
     /// rows) q'' is left as it is and the next Newmark step restores consistency.
     pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
         let t = self.state.t;
-        let m = mass_matrix(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
+        let (m, direct) = mass_matrix(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
+        if !direct {
+            self.stats.jacobian_evaluations += 1;
+        }
         let lu = LU::new(m);
         if !lu.is_invertible() {
             return Ok(());
