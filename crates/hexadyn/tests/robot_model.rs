@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use approx::assert_relative_eq;
 use hexadyn::physics::FlatGround;
-use hexadyn::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel, JOINTS};
+use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, Robot, RobotModel, JOINTS};
 use hexadyn::robot::RobotDescription;
 use hexadyn::sim::{finite_difference_jacobian, static_equilibrium, Jacobian, Newmark, NewmarkOptions, StaticOptions, System};
 
@@ -59,10 +59,19 @@ fn sinkage_on_three_legs() {
 /// friction model, with and without inductance, in a moving state with feet on the ground.
 #[test]
 fn analytic_jacobian_matches_finite_differences() {
-    for (friction, inductance, load) in [(FrictionModel::None, false, false), (FrictionModel::DryViscous, true, true), (FrictionModel::LuGre, true, true), (FrictionModel::LuGre, false, false)] {
+    let pid = JointControl::ContinuousPid { t_d: 0.01, n: 10.0, omega_0: 1000.0 };
+    for (friction, inductance, load, control) in [
+        (FrictionModel::None, false, false, JointControl::Digital),
+        (FrictionModel::DryViscous, true, true, JointControl::Digital),
+        (FrictionModel::LuGre, true, true, JointControl::Digital),
+        (FrictionModel::LuGre, false, false, JointControl::Digital),
+        (FrictionModel::LuGre, true, false, pid),
+        (FrictionModel::None, false, false, pid),
+    ] {
         let mut r = robot(friction, |o| {
             o.inductance = inductance;
             o.load_dependence = load;
+            o.control = control;
         });
         let mut q = r.model.touching_ground(&joints(&[0, 1, 2, 3, 4, 5]));
         let n = q.len();
@@ -72,7 +81,8 @@ fn analytic_jacobian_matches_finite_differences() {
         let qd: Vec<f64> = (0..n).map(|i| size(i) * ((i as f64) * 1.7).sin()).collect();
         let qdd: Vec<f64> = (0..n).map(|i| 10.0 * size(i) * ((i as f64) * 0.9).cos()).collect();
         for k in 0..JOINTS {
-            r.set_input(k, 3.0 * (k as f64).cos());
+            let reference = if control == JointControl::Digital { 3.0 * (k as f64).cos() } else { q[6 + k] + 1e-3 * (k as f64).cos() };
+            r.set_input(k, reference);
         }
         let mut exact = Jacobian::zeros(n);
         assert!(r.jacobian(0.0, &q, &qd, &qdd, &mut exact));
@@ -109,4 +119,17 @@ fn unpowered_robot_irreversibility() {
     assert!(lugre.abs() < 0.05e-3, "LuGre: {lugre}");
     assert!(none > 1e-3, "no friction sinks millimetres: {none}");
     assert!(lugre.abs() < dry && dry < none, "order LuGre < dry/viscous < none: {sink:?}");
+}
+
+/// Table 3.5: 49 bodies and 96 DOF with LuGre friction, motor inductances and continuous PID
+/// controllers (24 + 18 + 18 + 36); 42 for the simplified model of Section 4.5.
+#[test]
+fn coordinate_counts_of_table_3_5_and_section_4_5() {
+    let full = robot(FrictionModel::LuGre, |o| {
+        o.inductance = true;
+        o.control = JointControl::ContinuousPid { t_d: 0.0, n: 10.0, omega_0: 1000.0 };
+    });
+    assert_eq!(full.model.coordinate_count(), 96);
+    assert_eq!(full.model.mechanics.model.body_count(), 49);
+    assert_eq!(robot(FrictionModel::LuGre, |_| {}).model.coordinate_count(), 42);
 }

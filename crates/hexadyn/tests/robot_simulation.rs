@@ -3,9 +3,9 @@
 
 use std::sync::Arc;
 
-use hexadyn::control::{DigitalPi, JointMotion, JointPiController, JointReferences, JOINTS};
+use hexadyn::control::{DigitalPi, JointMotion, JointPiController, JointReferences, ReferenceFeed, JOINTS};
 use hexadyn::physics::FlatGround;
-use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
+use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
 use hexadyn::robot::{Joint, RobotDescription};
 
@@ -98,4 +98,41 @@ fn ramp_at_80_percent_of_no_load_speed() {
     println!("ramp {rate:.5} m/s: error at 0.5 s {:.4} mm, max |u| {worst_u:.2} V", error_at_half_second * 1e3);
     assert!(worst_u < d.motor.nominal_voltage_v, "saturates: {worst_u} V");
     assert!(error_at_half_second.abs() > 0.03e-3 && error_at_half_second.abs() < 0.3e-3, "error {error_at_half_second}");
+}
+
+/// The 96-DOF model (Table 3.5): continuous PI controllers inside the model (Eq. 3.96-3.97,
+/// T_D = 0) with the gains of Table 4.1 track the same tripod-stance motion as the digital ones,
+/// and its energy account closes too.
+#[test]
+fn continuous_pid_model_tracks_like_the_digital_controllers() {
+    let d = RobotDescription::amru5();
+    let base = tripod_stance();
+    let motions = vec![(3 + 1, JointMotion::Sine { amplitude: 0.004, frequency_hz: 0.5 })];
+    let mut errors = Vec::new();
+    for control in [JointControl::Digital, JointControl::ContinuousPid { t_d: 0.0, n: 10.0, omega_0: 1000.0 }] {
+        let m = model(FrictionModel::LuGre, |o| {
+            o.control = control;
+            o.inductance = control != JointControl::Digital;
+        });
+        let q = m.touching_ground(&base);
+        let qd = vec![0.0; q.len()];
+        let mut plant = SimulatedRobot::new(m, &q, &qd, &PlantOptions::from_description(&d)).unwrap();
+        let references = JointReferences { base, motions: motions.clone() };
+        let mut worst: f64 = 0.0;
+        let mut track = |p: &SimulatedRobot, meas: &hexadyn::control::Measurements, cmd: &hexadyn::control::Command| {
+            if meas.t > 0.5 {
+                worst = worst.max((cmd.references[4] - p.state().q[6 + 4]).abs());
+            }
+        };
+        match control {
+            JointControl::Digital => run(&mut plant, &mut JointPiController { pis: pis(&d), references }, 2.0, &mut track).unwrap(),
+            _ => run(&mut plant, &mut ReferenceFeed(references), 2.0, &mut track).unwrap(),
+        }
+        let electrical: f64 = plant.energy.electrical.iter().sum();
+        let imbalance = plant.energy.balance_error(&plant.initial_energy);
+        println!("{control:?}: worst q_v[1] error after 0.5 s {:.4} mm, imbalance {imbalance:.2e} of {electrical:.2} J", worst * 1e3);
+        assert!(imbalance.abs() < 0.01 * electrical);
+        errors.push(worst);
+    }
+    assert!(errors[1] < 2.0 * errors[0] && errors[0] < 2.0 * errors[1], "{errors:?}");
 }

@@ -52,8 +52,9 @@ pub trait Plant {
     /// Control period Δt (s).
     fn period(&self) -> f64;
     fn measure(&mut self) -> Measurements;
-    /// Applies the voltages for the next period (zero-order hold).
-    fn actuate(&mut self, voltages: &[f64; JOINTS]);
+    /// Applies the command for the next period (zero-order hold): the voltages, or the
+    /// references when the plant's joint controllers are its own.
+    fn actuate(&mut self, command: &Command);
     /// Lets one control period pass.
     fn wait_period(&mut self) -> Result<(), Self::Error>;
 }

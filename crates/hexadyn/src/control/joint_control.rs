@@ -74,6 +74,16 @@ impl<R: ReferenceSource> Controller for JointPiController<R> {
     }
 }
 
+/// Feeds the references to a plant whose joint controllers are continuous and internal (the
+/// 96-DOF model, Table 3.5); no voltage is computed here.
+pub struct ReferenceFeed<R: ReferenceSource>(pub R);
+
+impl<R: ReferenceSource> Controller for ReferenceFeed<R> {
+    fn update(&mut self, m: &Measurements) -> Command {
+        Command { voltages: [0.0; JOINTS], references: self.0.reference(m.t) }
+    }
+}
+
 /// No power: all voltages zero (the unpowered robot of Section 6.2). References are the
 /// measured positions.
 pub struct Unpowered;

@@ -7,5 +7,5 @@ mod joint_control;
 mod pi;
 
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant, JOINTS};
-pub use joint_control::{JointMotion, JointPiController, JointReferences, ReferenceSource, Unpowered};
+pub use joint_control::{JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};

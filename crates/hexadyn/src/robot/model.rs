@@ -4,9 +4,12 @@
 //! (inductance neglected, Eq. 4.4, or kept as 18 current states, Eq. 3.91).
 //!
 //! Rows and coordinates: q (24, Eq. 3.51), then the bristle states z = q'_z (Eq. 3.85), then the
-//! motor currents i = q'_i (Eq. 3.91) when they are states. Inputs: the 18 voltages commanded by
-//! the controllers, held between control instants (cut by the limit switches at the ends of the
-//! joint strokes, Section 2.3.1, see [`Robot::command`]) and saturated at the supply voltage.
+//! motor currents i = q'_i (Eq. 3.91) when they are states, then, with continuous joint
+//! controllers (the 96-DOF model of Table 3.5), per joint the PID states q_u (u = q'_u) and q_I
+//! (Eq. 3.96-3.97). Inputs: the 18 voltages commanded by the digital controllers, held between
+//! control instants (cut by the limit switches at the ends of the joint strokes, Section 2.3.1,
+//! see [`Robot::command`]) and saturated at the supply voltage; with continuous controllers, the
+//! 18 joint references instead.
 
 use std::ops::RangeInclusive;
 use std::sync::Arc;
@@ -20,6 +23,7 @@ use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Terrain};
 use crate::physics::{DryViscous, FrictionElement, JointFriction, LoadDependence, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
+use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
 
 pub use crate::control::JOINTS;
@@ -31,6 +35,18 @@ pub enum FrictionModel {
     None,
     DryViscous,
     LuGre,
+}
+
+/// Where the joint position controllers live.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum JointControl {
+    /// Digital PI controllers outside the model at the control period (Eq. 4.18-4.20): the
+    /// model's inputs are the motor voltages (the 42-DOF model of Section 4.5).
+    Digital,
+    /// Continuous PID controllers inside the model (Eq. 3.93-3.97) with the gains K, T_I of the
+    /// description: 36 more states, and the model's inputs are the joint references.
+    ContinuousPid { t_d: f64, n: f64, omega_0: f64 },
 }
 
 /// The modelling choices of a simulation.
@@ -45,6 +61,7 @@ pub struct ModelOptions {
     pub ground: GroundContact,
     /// Supply voltage at the H-bridges (V).
     pub supply_voltage: f64,
+    pub control: JointControl,
 }
 
 impl ModelOptions {
@@ -57,6 +74,7 @@ impl ModelOptions {
             inductance: false,
             ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s },
             supply_voltage: d.driver.supply_voltage_v,
+            control: JointControl::Digital,
         }
     }
 }
@@ -72,9 +90,13 @@ pub struct RobotModel {
     pub strokes: [RangeInclusive<f64>; 3],
     pub options: ModelOptions,
     pub terrain: Arc<dyn Terrain + Send + Sync>,
+    /// Continuous joint controllers (Eq. 3.96-3.97), with [`JointControl::ContinuousPid`].
+    pub pids: Option<[ContinuousPid; JOINTS]>,
     layout: Layout,
     bristles: Option<usize>,
     currents: Option<usize>,
+    /// First PID state: q_u of joint k at `pid + 2k`, q_I at `pid + 2k + 1`.
+    pid: Option<usize>,
 }
 
 fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
@@ -146,11 +168,27 @@ impl RobotModel {
             }
             first
         });
-        RobotModel { mechanics, motors, friction, strokes, options, terrain, layout, bristles, currents }
+        let pids = match options.control {
+            JointControl::Digital => None,
+            JointControl::ContinuousPid { t_d, n, omega_0 } => Some(std::array::from_fn(|k| {
+                let g = d.pi_gains(Joint::ALL[k % 3]);
+                ContinuousPid { k: g.k, t_i: g.t_i, t_d, n, omega_0 }
+            })),
+        };
+        let pid = pids.is_some().then(|| {
+            let first = layout.len();
+            for k in 0..JOINTS {
+                let element = format!("PID {}", joint_name(k));
+                layout.push(format!("q_u_{}", joint_name(k)), Order::First, 1e-3, element.clone());
+                layout.push(format!("q_I_{}", joint_name(k)), Order::Second, if k % 3 == 0 { 1e-6 } else { 1e-8 }, element);
+            }
+            first
+        });
+        RobotModel { mechanics, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
     }
 
-    /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance
-    /// (42 for the model of Section 4.5).
+    /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance,
+    /// + 36 with continuous PID controllers (42 for the model of Section 4.5, 96 for Table 3.5).
     pub fn coordinate_count(&self) -> usize {
         self.layout.len()
     }
@@ -215,23 +253,31 @@ pub struct Outputs {
 pub struct Robot {
     pub model: Arc<RobotModel>,
     pub data: Data,
-    /// Motor voltages held over the control period (inputs, V).
+    /// Motor voltages held over the control period (inputs with digital control, V).
     pub voltages: [f64; JOINTS],
+    /// Joint references (inputs with continuous PID control, rad or m).
+    pub references: [f64; JOINTS],
     pub outputs: Outputs,
 }
 
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
-        Robot { model, data, voltages: [0.0; JOINTS], outputs: Outputs::default() }
+        Robot { model, data, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default() }
     }
 
-    /// Holds the commanded voltages for the next control period, cut by the limit switches of
-    /// the joints that are beyond their stroke and pushed further out (Section 2.3.1). The
-    /// switches are read at the control instant, as the slave boards apply the commands.
-    pub fn command(&mut self, commanded: &[f64; JOINTS], q: &[f64]) {
-        for k in 0..JOINTS {
-            self.voltages[k] = limit_switch(commanded[k], q[6 + k], &self.model.strokes[k % 3]);
+    /// Holds a command for the next control period. Digital control: the voltages, cut by the
+    /// limit switches of the joints that are beyond their stroke and pushed further out
+    /// (Section 2.3.1), read at the control instant as the slave boards apply the commands.
+    /// Continuous PID control: the references.
+    pub fn command(&mut self, command: &Command, q: &[f64]) {
+        match self.model.pids {
+            None => {
+                for k in 0..JOINTS {
+                    self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k % 3]);
+                }
+            }
+            Some(_) => self.references = command.references,
         }
     }
 
@@ -258,7 +304,8 @@ impl Robot {
         for k in 0..JOINTS {
             let j = 6 + k;
             let motor = &m.motors[k];
-            let u = saturate(self.voltages[k], m.options.supply_voltage);
+            let commanded = m.pid.map_or(self.voltages[k], |p| qd[p + 2 * k]);
+            let u = saturate(commanded, m.options.supply_voltage);
             let i = match m.currents {
                 Some(c) => qd[c + k],
                 None => motor.current(qd[j], u).i,
@@ -289,6 +336,11 @@ impl Robot {
             if let Some(c) = m.currents {
                 f[c + k] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).f;
             }
+            if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
+                let (u, i) = (p + 2 * k, p + 2 * k + 1);
+                f[u] = pids[k].voltage_residual(qd[u], qdd[u], q[i], qd[i], qdd[i]).f;
+                f[i] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).f;
+            }
         }
     }
 }
@@ -308,6 +360,13 @@ impl Robot {
             }
             if let Some(c) = m.currents {
                 mass[(c + k, c + k)] = m.motors[k].l;
+            }
+            if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
+                let (u, i) = (p + 2 * k, p + 2 * k + 1);
+                let r = pids[k].voltage_residual(0.0, 0.0, 0.0, 0.0, 0.0);
+                mass[(u, u)] = r.df_dqdd_u;
+                mass[(u, i)] = r.df_dqdd_i;
+                mass[(i, i)] = pids[k].integral_residual(0.0, 0.0, 0.0).df_dqdd_i;
             }
         }
     }
@@ -367,6 +426,23 @@ impl System for Robot {
                 // f_j contains −τ_m = −n k_t i.
                 jac.ct[(j, c + k)] = -m.motors[k].joint_torque(1.0).1;
             }
+            if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
+                let (u, i) = (p + 2 * k, p + 2 * k + 1);
+                let r = pids[k].voltage_residual(qd[u], qdd[u], q[i], qd[i], qdd[i]);
+                jac.ct[(u, u)] = r.df_dqd_u;
+                jac.ct[(u, i)] = r.df_dqd_i;
+                jac.kt[(u, i)] = r.df_dq_i;
+                jac.ct[(i, i)] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).df_dqd_i;
+                // The controller output q'_u drives the motor through the saturation.
+                let passes = if qd[u].abs() < m.options.supply_voltage { 1.0 } else { 0.0 };
+                match m.currents {
+                    Some(c) => jac.ct[(c + k, u)] = -passes,
+                    None => {
+                        let motor = &m.motors[k];
+                        jac.ct[(j, u)] = -motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * passes;
+                    }
+                }
+            }
         }
         true
     }
@@ -381,10 +457,16 @@ impl System for Robot {
         JOINTS
     }
     fn input(&self, k: usize) -> f64 {
-        self.voltages[k]
+        match self.model.pids {
+            None => self.voltages[k],
+            Some(_) => self.references[k],
+        }
     }
     fn set_input(&mut self, k: usize, value: f64) {
-        self.voltages[k] = value;
+        match self.model.pids {
+            None => self.voltages[k] = value,
+            Some(_) => self.references[k] = value,
+        }
     }
 }
 

@@ -182,9 +182,9 @@ impl Plant for SimulatedRobot {
         }
     }
 
-    fn actuate(&mut self, voltages: &[f64; JOINTS]) {
+    fn actuate(&mut self, command: &Command) {
         let q = self.integrator.state().q.clone();
-        self.robot.command(voltages, q.as_slice());
+        self.robot.command(command, q.as_slice());
     }
 
     fn wait_period(&mut self) -> Result<(), SimError> {
@@ -220,7 +220,7 @@ pub fn run<P: Plant, C: Controller + ?Sized>(
         if i == periods {
             break;
         }
-        plant.actuate(&command.voltages);
+        plant.actuate(&command);
         plant.wait_period()?;
     }
     Ok(())
