@@ -9,3 +9,4 @@ mod pi;
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant, JOINTS};
 pub use joint_control::{JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};
+pub mod gait;
