@@ -4,3 +4,4 @@
 
 pub mod body_motion;
 pub mod heading;
+pub mod pattern;
