@@ -9,3 +9,5 @@ mod pi;
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant, JOINTS};
 pub use joint_control::{JointMotion, JointPiController, JointReferences, ReferenceSource, Unpowered};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};
+mod leg_kinematics;
+pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegKinematics, LegKinematicsError, Limit, Workspace};
