@@ -3,5 +3,6 @@
 //! controller that turns them into joint references through the legs' inverse kinematics.
 
 pub mod body_motion;
+pub mod controller;
 pub mod heading;
 pub mod pattern;

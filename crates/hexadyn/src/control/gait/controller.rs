@@ -1,0 +1,308 @@
+//! The gait controller (thesis Sections 7.3-7.6): heading velocities → desired body HTM →
+//! foot references (support: anchor points, Eq. 7.11; swing: AEP, Eq. 7.24-7.31) → inverse
+//! kinematics (Eq. 7.7) → joint references → 18 digital PI (Eq. 4.18-4.20) → motor voltages.
+//!
+//! It sees only what the real robot measures (encoder positions, currents, supply voltage) and,
+//! when the robot has one, the navigation system's body pose: the same code drives the
+//! simulated and the real robot.
+
+use nalgebra::Vector3;
+
+use super::body_motion::{BodyMotion, Pose};
+use super::heading::HeadingSource;
+use super::pattern::{FootCycle, FootPhase, GaitPattern};
+use crate::control::{Command, Controller, DigitalPi, LegKinematics, Measurements, Workspace, JOINTS};
+use crate::spatial::Htm;
+
+/// How the AEP is found during the swing (Section 7.5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AepMode {
+    /// Computed once at the start of the swing, constant swing velocity (Eq. 7.24-7.28, 7.30-7.31).
+    Periodic,
+    /// Recomputed at every control step, swing velocity of Eq. 7.29 saturated at twice its
+    /// steady-state value (Section 7.5.2).
+    Omnidirectional,
+}
+
+/// Parameters of the gait.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaitOptions {
+    /// Leg cycle time T (s).
+    pub period: f64,
+    pub pattern: GaitPattern,
+    pub cycle: FootCycle,
+    pub aep: AepMode,
+    /// Enhanced cycle: foot rise ΔZ during the takeoff (m, Section 7.6). Plain cycle: the top
+    /// of the swing (m).
+    pub lift: f64,
+    /// Control period Δt (s).
+    pub dt: f64,
+}
+
+/// The state of one leg.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Leg {
+    phase: FootPhase,
+    /// Anchor point {p_F/0}_0 of the support (Eq. 7.10), or the virtual one of the landing.
+    anchor: Vector3<f64>,
+    /// Horizontal foot reference in the leg frame during the swing.
+    swing_xy: Vector3<f64>,
+    /// Start of the current swing (leg frame) and its AEP, for the periodic mode.
+    swing_from: Vector3<f64>,
+    aep: Vector3<f64>,
+    /// Current foot reference (leg frame) and joint references.
+    foot: Vector3<f64>,
+    joints: Vector3<f64>,
+}
+
+/// Counters of what went wrong, for reports and tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GaitDiagnostics {
+    /// Foot references the inverse kinematics had to clamp into the joint ranges.
+    pub clamped_references: usize,
+    pub gait_switches: usize,
+}
+
+/// The periodic/omnidirectional gait controller on flat ground.
+pub struct GaitController {
+    pub options: GaitOptions,
+    legs_kinematics: [LegKinematics; 6],
+    workspaces: [Workspace; 6],
+    pis: [DigitalPi; JOINTS],
+    heading: Box<dyn HeadingSource>,
+    body: Option<BodyMotion>,
+    legs: [Leg; 6],
+    /// Time of the gait's origin (phase 0 of the pattern).
+    origin: f64,
+    pending: Option<GaitPattern>,
+    pub diagnostics: GaitDiagnostics,
+}
+
+impl GaitController {
+    pub fn new(options: GaitOptions, legs: [LegKinematics; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
+        let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), foot: Vector3::zeros(), joints: Vector3::zeros() };
+        GaitController { options, legs_kinematics: legs, workspaces, pis, heading, body: None, legs: [idle; 6], origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
+    }
+
+    /// Phase of each foot at the last update (for gait diagrams and the ≥ 3 feet check).
+    pub fn phases(&self) -> [FootPhase; 6] {
+        self.legs.map(|l| l.phase)
+    }
+    /// The desired body pose T*_{0,b} at the last update.
+    pub fn desired_pose(&self) -> Option<Pose> {
+        self.body.as_ref().map(|b| b.pose)
+    }
+    /// Foot references in the leg frames at the last update.
+    pub fn foot_references(&self) -> [Vector3<f64>; 6] {
+        self.legs.map(|l| l.foot)
+    }
+    pub fn workspaces(&self) -> &[Workspace; 6] {
+        &self.workspaces
+    }
+
+    /// Asks for another gait while walking. Legs in the air finish their swing; legs on the
+    /// ground do not lift until all six are down; then the new pattern starts at the phase of
+    /// one of its swing starts where no leg is caught mid-swing (or the fewest), so that no
+    /// more legs than the pattern lifts at once are ever in the air.
+    pub fn change_gait(&mut self, pattern: GaitPattern) {
+        self.pending = Some(pattern);
+    }
+
+    /// T_{0,b} T_{b,l} for a body pose.
+    fn leg_frame(&self, leg: usize, body: &Htm) -> Htm {
+        body.compose(&self.legs_kinematics[leg].body_from_leg())
+    }
+
+    /// First update: the body pose (navigation, or the feet on flat ground at z = 0) and the
+    /// anchors of the six feet from the measured joints.
+    fn start(&mut self, m: &Measurements) {
+        let feet: Vec<Vector3<f64>> = (0..6).map(|l| self.legs_kinematics[l].foot_in_body(&joints_of(m, l))).collect();
+        let pose = m.pose.map_or_else(
+            || Pose { position: Vector3::new(0.0, 0.0, -feet.iter().map(|f| f.z).sum::<f64>() / 6.0), angles: Vector3::zeros() },
+            |p| Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) },
+        );
+        let htm = pose.htm();
+        for l in 0..6 {
+            let q = joints_of(m, l);
+            let foot = self.legs_kinematics[l].foot(&q);
+            self.legs[l].foot = foot;
+            self.legs[l].joints = q;
+            self.legs[l].anchor = self.leg_frame(l, &htm).apply(&foot);
+        }
+        self.body = Some(BodyMotion::new(pose));
+        self.origin = m.t;
+    }
+
+    /// The body pose the anchors are computed with: the navigation system's, or the desired
+    /// one when the robot has none (it is assumed to follow its reference, Section 7.4).
+    fn estimated_pose(&self, m: &Measurements, desired: &Pose) -> Htm {
+        m.pose.map_or_else(|| desired.htm(), |p| Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) }.htm())
+    }
+
+    /// Foot lift (normal to the body plane) at local phase φ: the enhanced cycle rises at
+    /// constant speed ΔZ / (1.5 Δφ T) from the takeoff to mid-swing and comes down
+    /// symmetrically to the end of the landing (Section 7.6); the plain cycle is a triangle of
+    /// height `lift` over the swing (Fig. 7.12).
+    fn lift(&self, phi: f64) -> f64 {
+        let o = &self.options;
+        let beta = self.current_pattern().beta;
+        match o.cycle {
+            FootCycle::Plain => {
+                let s = ((phi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
+                o.lift * (1.0 - (2.0 * s - 1.0).abs())
+            }
+            FootCycle::Enhanced { overlap } => {
+                let rate = o.lift / (1.5 * overlap);
+                (rate * (phi - (beta + overlap / 2.0)).min((1.0 - overlap / 2.0) - phi)).max(0.0)
+            }
+        }
+    }
+
+    fn current_pattern(&self) -> &GaitPattern {
+        &self.options.pattern
+    }
+
+    /// AEP in the leg frame (Eq. 7.24 / 7.30): the workspace centre C moved by the velocity of C
+    /// over half the support.
+    fn aep(&self, leg: usize, frame: &Htm, body: &BodyMotion, z: f64) -> Vector3<f64> {
+        let o = &self.options;
+        let c_leg = self.workspaces[leg].centre_at(z);
+        let c_body = self.legs_kinematics[leg].to_body(&c_leg);
+        // Eq. 7.25, expressed in the leg frame.
+        let v_c = frame.rotation.transpose() * body.point_velocity(&c_body);
+        let mut aep = c_leg + v_c * (o.cycle.support_fraction(self.current_pattern().beta) * o.period / 2.0);
+        aep.z = z;
+        aep
+    }
+
+    /// Switches to the pending pattern when all feet are down.
+    fn try_switch(&mut self, t: f64) {
+        if self.pending.is_none() || self.legs.iter().any(|l| l.phase != FootPhase::Support) {
+            return;
+        }
+        let next = self.pending.take().expect("pending");
+        let cycle = self.options.cycle;
+        // Candidate origins: the new pattern started just at one of its swing starts.
+        let mut best = (usize::MAX, 0.0);
+        for leg in 0..6 {
+            let g = (next.beta - next.offsets[leg]).rem_euclid(1.0);
+            let mid_swing = (0..6)
+                .filter(|&l| {
+                    let phi = (g + next.offsets[l]).rem_euclid(1.0);
+                    let start = cycle.swing_start(next.beta) - cycle.transition_fraction();
+                    !cycle.phase(phi, next.beta).on_ground() && phi > start + 1e-9
+                })
+                .count();
+            if mid_swing < best.0 {
+                best = (mid_swing, g);
+            }
+        }
+        // Phase g at time t: origin = t − g T, nudged back by a step so that the first legs
+        // start their cycle at this update.
+        self.origin = t - best.1 * self.options.period + 1e-9;
+        self.options.pattern = next;
+        self.diagnostics.gait_switches += 1;
+    }
+}
+
+fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
+    Vector3::new(m.positions[3 * leg], m.positions[3 * leg + 1], m.positions[3 * leg + 2])
+}
+
+impl Controller for GaitController {
+    fn update(&mut self, m: &Measurements) -> Command {
+        if self.body.is_none() {
+            self.start(m);
+        } else {
+            // Eq. 7.12-7.23: the desired body HTM from the heading velocities.
+            let h = self.heading.heading(m.t);
+            let dt = self.options.dt;
+            self.body.as_mut().expect("started").step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), dt);
+        }
+        self.try_switch(m.t);
+        let body = self.body.clone().expect("started");
+        let desired = body.pose.htm();
+        let estimated = self.estimated_pose(m, &body.pose);
+        let o = self.options.clone();
+        let beta = o.pattern.beta;
+        let swing_time = o.cycle.swing_fraction(beta) * o.period;
+        let mut references = [0.0; JOINTS];
+        for l in 0..6 {
+            let phi = o.pattern.phase(l, m.t - self.origin, o.period);
+            let mut target = o.cycle.phase(phi, beta);
+            let leg = self.legs[l];
+            // While a new gait is pending, no foot leaves the ground.
+            if self.pending.is_some() && leg.phase == FootPhase::Support {
+                target = FootPhase::Support;
+            }
+            // A foot only lands through the landing (or, plain cycle, ends its swing).
+            if leg.phase == FootPhase::Support && target == FootPhase::Landing {
+                target = FootPhase::Support;
+            }
+            let frame_desired = self.leg_frame(l, &desired);
+            let frame_estimated = self.leg_frame(l, &estimated);
+            let support_foot = frame_desired.inverse().apply(&leg.anchor); // Eq. 7.11
+            let mut next = leg;
+            next.phase = target;
+            match (leg.phase, target) {
+                // Entering the swing: start from the current horizontal reference.
+                (FootPhase::Support | FootPhase::Takeoff, FootPhase::Swing) => {
+                    next.swing_from = Vector3::new(leg.foot.x, leg.foot.y, support_foot.z);
+                    next.swing_xy = next.swing_from;
+                    next.aep = self.aep(l, &frame_desired, &body, support_foot.z);
+                }
+                // Touching down: the anchor (virtual AEP of the landing, Section 7.6) where the
+                // foot reference is, seen with the estimated body pose.
+                (FootPhase::Swing, FootPhase::Landing | FootPhase::Support) => {
+                    let mut foot = leg.swing_xy;
+                    foot.z = support_foot.z;
+                    next.anchor = frame_estimated.apply(&foot);
+                    next.anchor.z = leg.anchor.z;
+                }
+                _ => {}
+            }
+            let lift = if target == FootPhase::Support { 0.0 } else { self.lift(phi) };
+            next.foot = match target {
+                FootPhase::Support | FootPhase::Takeoff | FootPhase::Landing => {
+                    let mut p = frame_desired.inverse().apply(&next.anchor);
+                    p.z += lift;
+                    p
+                }
+                FootPhase::Swing => {
+                    let remaining = ((o.cycle.swing_start(beta) + o.cycle.swing_fraction(beta) - phi) * o.period).max(o.dt);
+                    let velocity = match o.aep {
+                        // Eq. 7.26 / 7.31.
+                        AepMode::Periodic => (next.aep - next.swing_from) / swing_time,
+                        // Eq. 7.29 with the saturation at twice the steady swing velocity.
+                        AepMode::Omnidirectional => {
+                            let aep = self.aep(l, &frame_desired, &body, support_foot.z);
+                            next.aep = aep;
+                            let v = (aep - next.swing_xy) / remaining;
+                            let steady = 2.0 * (aep - self.workspaces[l].centre_at(aep.z)).norm() / swing_time;
+                            let limit = 2.0 * steady;
+                            if v.norm() > limit && limit > 0.0 {
+                                v * (limit / v.norm())
+                            } else {
+                                v
+                            }
+                        }
+                    };
+                    // Eq. 7.27-7.28 (the vertical is the lift profile).
+                    next.swing_xy += Vector3::new(velocity.x, velocity.y, 0.0) * o.dt;
+                    Vector3::new(next.swing_xy.x, next.swing_xy.y, support_foot.z + lift)
+                }
+            };
+            // Eq. 7.7 from the previous references.
+            let ik = self.legs_kinematics[l].inverse(&next.foot, &leg.joints).expect("finite foot reference");
+            if !ik.is_reached() {
+                self.diagnostics.clamped_references += 1;
+            }
+            next.joints = ik.joints;
+            self.legs[l] = next;
+            references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
+        }
+        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
+        Command { voltages, references }
+    }
+}
