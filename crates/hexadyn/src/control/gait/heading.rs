@@ -141,6 +141,21 @@ impl Spline {
     pub fn new(t: &[f64], x: &[f64], y: &[f64]) -> Self {
         Spline { x: CubicSpline::natural(t, x), y: CubicSpline::natural(t, y) }
     }
+    /// The same path turned about its first waypoint so that it starts along +x: a robot
+    /// starting with zero yaw then keeps its yaw tangent to the path.
+    pub fn starting_along_x(t: &[f64], x: &[f64], y: &[f64]) -> Self {
+        let raw = Spline::new(t, x, y);
+        let (_, _, yaw0) = raw.pose(t[0]);
+        let (s, c) = (-yaw0).sin_cos();
+        let xr: Vec<f64> = x.iter().zip(y).map(|(a, b)| c * (a - x[0]) - s * (b - y[0])).collect();
+        let yr: Vec<f64> = x.iter().zip(y).map(|(a, b)| s * (a - x[0]) + c * (b - y[0])).collect();
+        Spline::new(t, &xr, &yr)
+    }
+    /// Section 7.5.3's spline (Fig. 7.13 is lost): a winding path of about 2.2 m in 200 s,
+    /// speed below 2 cm/s, with V_x, V_y and Ω_z all varying.
+    pub fn section_7_5_3() -> Self {
+        Spline::starting_along_x(&[0.0, 50.0, 100.0, 150.0, 200.0], &[0.0, 0.6, 1.1, 1.5, 2.0], &[0.0, 0.2, -0.1, -0.45, -0.3])
+    }
     /// Position and yaw (tangent) at t.
     pub fn pose(&self, t: f64) -> (f64, f64, f64) {
         let (dx, dy) = (self.x.derivative(t).0, self.y.derivative(t).0);
@@ -261,6 +276,15 @@ mod tests {
         assert_relative_eq!(px, ex, epsilon = 1e-5);
         assert_relative_eq!(py, ey, epsilon = 1e-5);
         assert_relative_eq!(yaw, eyaw, epsilon = 1e-3);
+    }
+
+    #[test]
+    fn built_in_spline_starts_along_x_below_two_cm_per_second() {
+        let mut s = Spline::section_7_5_3();
+        assert!(s.pose(0.0).2.abs() < 1e-12);
+        let speeds: Vec<f64> = (0..2000).map(|i| s.heading(i as f64 * 0.1).velocity.norm()).collect();
+        assert!(speeds.iter().all(|&v| v < 0.02), "{:?}", speeds.iter().cloned().fold(0.0, f64::max));
+        assert!((0..200).any(|i| s.heading(i as f64).yaw_rate.abs() > 1e-4));
     }
 
     #[test]
