@@ -1,6 +1,13 @@
 """hexadyn: multiphysics dynamics and gait control of six-legged walking robots.
 
-The numerics live in the Rust engine (``hexadyn._core``); this package is the user's front.
+The numerics live in the Rust engine (``hexadyn._core``); this package is the user's front::
+
+    import hexadyn
+    results = hexadyn.simulate("stand_six_legs")     # a shipped scenario or a scenario file
+    results.timeseries["Z"]                          # pandas DataFrame indexed by t (s)
+    results.units["Z"], results.summary["body_height_change_m"]
+    results.save("results/stand")                    # atomic; hexadyn.Results.load(folder)
+    hexadyn.list_scenarios()                         # the shipped scenario files
 """
 
 from __future__ import annotations
@@ -8,8 +15,19 @@ from __future__ import annotations
 from pathlib import Path
 
 from hexadyn._core import __version__
+from hexadyn.results import Results
+from hexadyn.runner import SCENARIOS_DIR, list_scenarios, resolve_scenario, simulate
 
-__all__ = ["__version__", "DEFAULT_ROBOT", "default_robot_path"]
+__all__ = [
+    "__version__",
+    "DEFAULT_ROBOT",
+    "default_robot_path",
+    "Results",
+    "SCENARIOS_DIR",
+    "list_scenarios",
+    "resolve_scenario",
+    "simulate",
+]
 
 #: Name of the default robot description (the AMRU5 of the thesis).
 DEFAULT_ROBOT = "amru5"

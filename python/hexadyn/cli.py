@@ -7,10 +7,19 @@ Set ``HEXADYN_DEBUG=1`` to see the traceback of such an error.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import click
 
 import hexadyn
+
+#: Scenario run by `hexadyn simulate` without an argument (and by `make run`): a shipped scenario
+#: name or a path. For now the robot standing on six legs; switch it to the walking validation
+#: case (Table 6.2) once that scenario exists.
+DEFAULT_SCENARIO = "stand_six_legs"
+
+#: Folder under which `hexadyn simulate` writes results when no --out is given.
+RESULTS_ROOT = Path("results")
 
 # Exceptions that report bad input (a missing file, a wrong value in a scenario) rather than a
 # bug: they are shown as one clean line.
@@ -47,6 +56,69 @@ def info() -> None:
         click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT} (description not shipped yet)")
     else:
         click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT} ({robot})")
+
+
+@cli.command()
+@click.argument("scenario", required=False, default=None)
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Results folder (default: results/<scenario name>, numbered if it exists).",
+)
+@click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
+@click.option("--no-progress", is_flag=True, help="No progress bar.")
+def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool) -> None:
+    """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
+
+    Without SCENARIO the default scenario is run (see `hexadyn scenarios`).
+    """
+    from hexadyn import _core
+
+    path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
+    # Validate before anything is created: a bad scenario leaves no results folder behind.
+    info = _core.load_scenario(str(path))
+    if out is None:
+        out = _free_folder(RESULTS_ROOT / info["name"])
+    elif out.exists() and not overwrite:
+        raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
+    results = hexadyn.simulate(path, out=out, progress=not no_progress, overwrite=overwrite)
+    s = results.summary
+    click.echo(f"Results: {out}")
+    click.echo(f"  scenario    {info['name']} ({path})")
+    click.echo(f"  simulated   {s['duration_s']:.3f} s in {s['wall_time_s']:.2f} s wall time, {s['integration_steps']} steps ({s['rejected_steps']} rejected)")
+    click.echo(f"  series      {results.timeseries.shape[0]} instants x {results.timeseries.shape[1]} columns")
+    click.echo(f"  body height {s['body_height_change_m'] * 1e3:+.4f} mm over the run")
+    click.echo(
+        f"  energy      electrical {s['energy_electrical_j']:.4g} J, Joule {s['energy_joule_j']:.4g} J, "
+        f"friction {s['energy_friction_j']:.4g} J, balance error {s['energy_balance_error_j']:.3g} J"
+    )
+    click.echo(f"  voltages    max |u| {s['max_abs_voltage_v']:.2f} V, saturated {100 * s['saturated_fraction']:.2f} % of commands, {s['limit_switch_cuts']} limit-switch cuts")
+
+
+@cli.command()
+def scenarios() -> None:
+    """List the shipped scenarios (run one with `hexadyn simulate NAME`)."""
+    from hexadyn import _core
+
+    files = hexadyn.list_scenarios()
+    click.echo(f"Shipped scenarios ({hexadyn.SCENARIOS_DIR}):")
+    width = max((len(p.stem) for p in files), default=0)
+    for p in files:
+        info = _core.load_scenario(str(p))
+        default = " (default)" if p.stem == DEFAULT_SCENARIO else ""
+        click.echo(f"  {p.stem:<{width}}  {info['duration_s']:>6g} s  {info['description']}{default}")
+
+
+def _free_folder(base: Path) -> Path:
+    """`base`, or `base-2`, `base-3`... whichever does not exist yet."""
+    if not base.exists():
+        return base
+    n = 2
+    while (candidate := base.with_name(f"{base.name}-{n}")).exists():
+        n += 1
+    return candidate
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -867,10 +867,13 @@ impl RobotDescription {
 }
 
 /// Byte spans of every key and value of the document, to turn serde errors and validation
-/// paths into dotted field paths and line numbers.
-struct SpanIndex<'t> {
+/// paths into dotted field paths and line numbers. Shared with the scenario loader
+/// (`robot::scenario`), which reports errors the same way.
+pub(crate) struct SpanIndex<'t> {
     file: String,
     text: &'t str,
+    /// Where a reader finds the required fields, quoted in "missing field" errors.
+    reference: String,
     /// (dotted path, key span, value span); array elements use the element span for both.
     nodes: Vec<(String, Range<usize>, Range<usize>)>,
 }
@@ -890,6 +893,12 @@ fn shorten(s: &str) -> String {
 
 impl<'t> SpanIndex<'t> {
     fn build(text: &'t str, file: &str) -> Result<Self> {
+        Self::build_for(text, file, "robots/amru5.toml")
+    }
+
+    /// Indexes `text` (read from `file`); `reference` names the file or document that shows
+    /// the required fields, for "missing field" errors.
+    pub(crate) fn build_for(text: &'t str, file: &str, reference: &str) -> Result<Self> {
         let doc = toml::de::DeTable::parse(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
             DescriptionError::Syntax {
@@ -899,7 +908,7 @@ impl<'t> SpanIndex<'t> {
                 message: e.message().trim().to_string(),
             }
         })?;
-        let mut index = SpanIndex { file: file.to_string(), text, nodes: Vec::new() };
+        let mut index = SpanIndex { file: file.to_string(), text, reference: reference.to_string(), nodes: Vec::new() };
         index.walk_table(doc.get_ref(), "");
         Ok(index)
     }
@@ -948,11 +957,20 @@ impl<'t> SpanIndex<'t> {
         best.map(|(_, _, p, v)| (p, v))
     }
 
-    fn line_of(&self, path: &str) -> Option<usize> {
-        self.nodes.iter().find(|(p, ..)| p == path).map(|(_, key, _)| line_col(self.text, key.start).0)
+    /// Line of the field at `path`, or of its closest enclosing table or array element that is
+    /// in the file (a missing field is reported at its table).
+    pub(crate) fn line_of(&self, path: &str) -> Option<usize> {
+        let mut path = path;
+        loop {
+            if let Some((_, key, _)) = self.nodes.iter().find(|(p, ..)| p == path) {
+                return Some(line_col(self.text, key.start).0);
+            }
+            let cut = path.rfind(['.', '['])?;
+            path = &path[..cut];
+        }
     }
 
-    fn serde_error(&self, e: &toml::de::Error) -> DescriptionError {
+    pub(crate) fn serde_error(&self, e: &toml::de::Error) -> DescriptionError {
         let msg = e.message().trim().to_string();
         let span = e.span().filter(|s| s.start < s.end);
         let line = span.as_ref().map(|s| line_col(self.text, s.start).0);
@@ -974,7 +992,7 @@ impl<'t> SpanIndex<'t> {
                 join(&parent, &quoted(&msg)),
                 "<missing>".to_string(),
                 "missing field",
-                "the field is required (see robots/amru5.toml)".to_string(),
+                format!("the field is required (see {})", self.reference),
             );
         }
         let expected = msg
@@ -1009,13 +1027,13 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 // Validation
 // =============================================================================================
 
-struct Ctx<'a> {
-    file: &'a str,
-    index: Option<&'a SpanIndex<'a>>,
+pub(crate) struct Ctx<'a> {
+    pub(crate) file: &'a str,
+    pub(crate) index: Option<&'a SpanIndex<'a>>,
 }
 
 impl Ctx<'_> {
-    fn err(
+    pub(crate) fn err(
         &self,
         field: &str,
         value: impl fmt::Display,
@@ -1032,7 +1050,7 @@ impl Ctx<'_> {
         )
     }
 
-    fn check(&self, ok: bool, field: &str, value: f64, allowed: &str) -> Result<()> {
+    pub(crate) fn check(&self, ok: bool, field: &str, value: f64, allowed: &str) -> Result<()> {
         if !value.is_finite() {
             return Err(self.err(field, value, "not a finite number", allowed));
         }
@@ -1043,15 +1061,15 @@ impl Ctx<'_> {
         }
     }
 
-    fn finite(&self, field: &str, v: f64) -> Result<()> {
+    pub(crate) fn finite(&self, field: &str, v: f64) -> Result<()> {
         self.check(true, field, v, "a finite number")
     }
 
-    fn positive(&self, field: &str, v: f64) -> Result<()> {
+    pub(crate) fn positive(&self, field: &str, v: f64) -> Result<()> {
         self.check(v > 0.0, field, v, "a finite number > 0")
     }
 
-    fn non_negative(&self, field: &str, v: f64) -> Result<()> {
+    pub(crate) fn non_negative(&self, field: &str, v: f64) -> Result<()> {
         self.check(v >= 0.0, field, v, "a finite number >= 0")
     }
 
@@ -1059,7 +1077,7 @@ impl Ctx<'_> {
         self.check(v < 0.0, field, v, "a finite number < 0 (minus sense, q_dot < 0)")
     }
 
-    fn within(&self, field: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
+    pub(crate) fn within(&self, field: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
         self.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}]"))
     }
 

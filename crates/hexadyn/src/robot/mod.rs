@@ -7,6 +7,11 @@
 //! ([`DescriptionError`]). SI accessors (radians, kg m^2, H, per-leg friction in joint units
 //! after the rules of Section 6.1) sit on top of the raw mirror.
 //!
+//! [`model`] is the complete robot as one residual system and [`simulation`] the simulated
+//! robot driven by a controller. [`scenario`] reads ready-to-run simulations from TOML files
+//! (reporting errors the same way as the description) and runs them into time series with
+//! units ([`recorder`]).
+//!
 //! ```
 //! use hexadyn::robot::{Joint, RobotDescription};
 //! let robot = RobotDescription::amru5();
@@ -19,6 +24,8 @@ pub mod description;
 pub mod mechanics;
 pub mod model;
 pub mod pantograph;
+pub mod recorder;
+pub mod scenario;
 pub mod simulation;
 
 pub use description::{

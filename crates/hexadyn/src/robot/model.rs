@@ -32,9 +32,24 @@ pub use crate::control::JOINTS;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FrictionModel {
+    /// `"none"`: no joint friction.
     None,
+    /// `"dry_viscous"`: dry and viscous friction regularised around zero velocity (Eq. 6.1).
     DryViscous,
+    /// `"lugre"`: the LuGre model with one bristle state per joint (Eq. 3.83-3.87).
+    #[serde(rename = "lugre")]
     LuGre,
+}
+
+impl FrictionModel {
+    /// The name used in scenario files: `none`, `dry_viscous` or `lugre`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrictionModel::None => "none",
+            FrictionModel::DryViscous => "dry_viscous",
+            FrictionModel::LuGre => "lugre",
+        }
+    }
 }
 
 /// Where the joint position controllers live.

@@ -2,6 +2,7 @@
 //! instants, encoders quantizing the joint positions, and an energy account integrated at every
 //! accepted step (electrical input, Joule, friction and contact losses, stored energies).
 
+use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use super::model::{Robot, RobotModel};
@@ -212,16 +213,34 @@ pub fn run<P: Plant, C: Controller + ?Sized>(
     duration: f64,
     mut record: impl FnMut(&P, &Measurements, &Command),
 ) -> Result<(), P::Error> {
+    run_until(plant, controller, duration, |p, m, c| {
+        record(p, m, c);
+        ControlFlow::Continue(())
+    })
+    .map(|_| ())
+}
+
+/// [`run`] with a `record` that may stop the run early (e.g. a user interrupt) by returning
+/// `ControlFlow::Break(())` at an instant: that instant's command is not applied. Returns
+/// `Break` when stopped so, `Continue` when the whole duration ran.
+pub fn run_until<P: Plant, C: Controller + ?Sized>(
+    plant: &mut P,
+    controller: &mut C,
+    duration: f64,
+    mut record: impl FnMut(&P, &Measurements, &Command) -> ControlFlow<()>,
+) -> Result<ControlFlow<()>, P::Error> {
     let periods = (duration / plant.period()).round() as usize;
     for i in 0..=periods {
         let m = plant.measure();
         let command = controller.update(&m);
-        record(plant, &m, &command);
+        if record(plant, &m, &command).is_break() {
+            return Ok(ControlFlow::Break(()));
+        }
         if i == periods {
             break;
         }
         plant.actuate(&command);
         plant.wait_period()?;
     }
-    Ok(())
+    Ok(ControlFlow::Continue(()))
 }
