@@ -23,11 +23,14 @@ fn walk(friction: FrictionModel, heading: Box<dyn HeadingSource>, navigation: bo
 }
 
 fn walk_with(friction: FrictionModel, heading: Box<dyn HeadingSource>, navigation: bool, cycle: FootCycle, aep: AepMode, tweak: impl FnOnce(&mut ModelOptions)) -> Walk {
+    walk_lifting(0.045, friction, heading, navigation, cycle, aep, tweak)
+}
+
+fn walk_lifting(lift: f64, friction: FrictionModel, heading: Box<dyn HeadingSource>, navigation: bool, cycle: FootCycle, aep: AepMode, tweak: impl FnOnce(&mut ModelOptions)) -> Walk {
     let d = RobotDescription::amru5();
     let legs = LegKinematics::hexapod_from_description(&d).unwrap();
     let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
-    let lift = 0.015;
-    let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, 3.0 * lift).unwrap());
+    let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
     let mut joints = [0.0; JOINTS];
     for l in 0..6 {
         let c = workspaces[l].centre_at(-height);
@@ -98,17 +101,18 @@ fn path(name: &str) -> Box<dyn HeadingSource> {
 /// sharp 90° turns and the spline (V_x, V_y, Ω_z all non-zero, yaw tangent), the body's XY
 /// tracking error stays at or below 3 mm, and every foot reference stays in its workspace.
 #[test]
-#[ignore = "being tuned: fails today"]
 fn omnidirectional_paths_with_navigation() {
     for (name, duration) in [("back and forth", 200.0), ("straight lines", 80.0), ("spline", 200.0)] {
         let mut w = walk_with(FrictionModel::None, path(name), true, FootCycle::Enhanced { overlap: 0.05 }, AepMode::Omnidirectional, |_| {});
         let workspaces = *w.controller.workspaces();
-        let (mut worst_xy, mut worst_outside, mut worst_yaw) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut worst_xy, mut worst_outside, mut worst_yaw, mut worst_t) = (0.0f64, 0.0f64, 0.0f64, 0.0);
         drive(&mut w, duration, |p, c, m| {
             let q = &p.state().q;
             if let Some(desired) = c.desired_pose() {
-                if m.t > 1.0 {
-                    worst_xy = worst_xy.max((desired.position.xy() - Vector3::new(q[0], q[1], 0.0).xy()).norm());
+                let e = (desired.position.xy() - Vector3::new(q[0], q[1], 0.0).xy()).norm();
+                if m.t > 1.0 && e > worst_xy {
+                    worst_xy = e;
+                    worst_t = m.t;
                     worst_yaw = worst_yaw.max((desired.angles.x - q[3]).abs());
                 }
             }
@@ -116,7 +120,7 @@ fn omnidirectional_paths_with_navigation() {
                 worst_outside = worst_outside.max(workspaces[l].distance_outside(foot));
             }
         });
-        println!("{name}: worst XY error {:.2} mm, yaw {:.3} deg, foot outside workspace by {:.2} mm, {:?}", worst_xy * 1e3, worst_yaw.to_degrees(), worst_outside * 1e3, w.controller.diagnostics);
+        println!("{name}: worst XY error {:.2} mm at {worst_t:.2} s, yaw {:.3} deg, foot outside workspace by {:.2} mm, {:?}", worst_xy * 1e3, worst_yaw.to_degrees(), worst_outside * 1e3, w.controller.diagnostics);
         assert!(worst_xy <= 3e-3, "{name}: XY error {worst_xy}");
         assert!(worst_outside <= 1e-3, "{name}: a foot leaves its workspace by {worst_outside}");
     }
@@ -125,7 +129,6 @@ fn omnidirectional_paths_with_navigation() {
 /// Section 7.5.2: after the velocity reversal of the back-and-forth path, the strokes re-centre
 /// on the workspace centre within 2 steps.
 #[test]
-#[ignore = "being tuned: fails today"]
 fn strokes_recentre_within_two_steps_after_a_velocity_change() {
     let mut w = walk_with(FrictionModel::None, path("back and forth"), true, FootCycle::Enhanced { overlap: 0.05 }, AepMode::Omnidirectional, |_| {});
     let workspaces = *w.controller.workspaces();
@@ -146,7 +149,10 @@ fn strokes_recentre_within_two_steps_after_a_velocity_change() {
     });
     for l in 0..6 {
         let centre = workspaces[l].centre;
-        for (start, first, last) in supports[l].iter().filter(|(t, _, _)| *t > 140.0 + 2.0 * 12.0) {
+        // Complete supports (the last one may be cut by the end of the run) starting two steps
+        // after the reversal.
+        let complete = &supports[l][..supports[l].len() - usize::from(previous[l] == FootPhase::Support)];
+        for (start, first, last) in complete.iter().filter(|(t, _, _)| *t > 140.0 + 2.0 * 12.0) {
             let middle = ((first + last) / 2.0).xy();
             let offset = (middle - centre).norm();
             assert!(offset < 0.01, "leg {l}: stroke starting at {start:.1} s centred {:.1} mm off C", offset * 1e3);
@@ -157,16 +163,16 @@ fn strokes_recentre_within_two_steps_after_a_velocity_change() {
 /// Fig. 7.24: on soft ground (K_gnd = 1e4), walking straight at 2 cm/s without navigation, the
 /// enhanced foot cycle tracks X at least 3 times better than the plain cycle at the end.
 #[test]
-#[ignore = "being tuned: fails today"]
 fn enhanced_cycle_tracks_better_on_soft_ground() {
     let mut errors = Vec::new();
     for cycle in [FootCycle::Enhanced { overlap: 0.05 }, FootCycle::Plain] {
-        let mut w = walk_with(FrictionModel::None, Box::new(Constant(Heading::new(0.02, 0.0, 0.0))), false, cycle, AepMode::Periodic, |o| o.ground.k_gnd = 1e4);
+        // The feet sink about 5 cm: a clearance of 10 cm takes the swinging feet out of the soil.
+        let mut w = walk_lifting(0.1, FrictionModel::None, Box::new(Constant(Heading::new(0.02, 0.0, 0.0))), false, cycle, AepMode::Periodic, |o| o.ground.k_gnd = 1e4);
         let mut error = 0.0;
         drive(&mut w, 72.0, |p, c, _| {
             error = c.desired_pose().map_or(0.0, |d| d.position.x - p.state().q[0]);
         });
-        println!("{cycle:?}: final X tracking error {:.2} mm", error * 1e3);
+        println!("{cycle:?}: final X tracking error {:.2} mm, {:?}", error * 1e3, w.controller.diagnostics);
         errors.push(error.abs());
     }
     assert!(errors[0] * 3.0 <= errors[1], "enhanced {} vs plain {}", errors[0], errors[1]);
@@ -203,3 +209,4 @@ fn gait_changes_keep_three_feet_down() {
     assert_eq!(switched.last().unwrap(), "tripod");
     assert!(min_feet >= 3);
 }
+

@@ -33,8 +33,9 @@ pub struct GaitOptions {
     pub pattern: GaitPattern,
     pub cycle: FootCycle,
     pub aep: AepMode,
-    /// Enhanced cycle: foot rise ΔZ during the takeoff (m, Section 7.6). Plain cycle: the top
-    /// of the swing (m).
+    /// Foot clearance: the top of the foot's lift above its support level at mid-swing (m). The
+    /// enhanced cycle reaches it rising at the constant speed of its takeoff (Section 7.6), the
+    /// plain cycle with a triangular profile (Fig. 7.12).
     pub lift: f64,
     /// Control period Δt (s).
     pub dt: f64,
@@ -140,23 +141,20 @@ impl GaitController {
         m.pose.map_or_else(|| desired.htm(), |p| Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) }.htm())
     }
 
-    /// Foot lift (normal to the body plane) at local phase φ: the enhanced cycle rises at
-    /// constant speed ΔZ / (1.5 Δφ T) from the takeoff to mid-swing and comes down
-    /// symmetrically to the end of the landing (Section 7.6); the plain cycle is a triangle of
-    /// height `lift` over the swing (Fig. 7.12).
+    /// Foot lift (normal to the body plane) at local phase φ, a triangle of height `lift`: over
+    /// the swing for the plain cycle (Fig. 7.12); from the start of the takeoff to the end of
+    /// the landing for the enhanced cycle, which so rises at constant speed through the takeoff
+    /// and the first half of the swing and comes down symmetrically (Section 7.6; the takeoff
+    /// rise ΔZ is a third of the clearance for β = 1/2, Δφ = 5 %).
     fn lift(&self, phi: f64) -> f64 {
         let o = &self.options;
         let beta = self.current_pattern().beta;
-        match o.cycle {
-            FootCycle::Plain => {
-                let s = ((phi - beta) / (1.0 - beta)).clamp(0.0, 1.0);
-                o.lift * (1.0 - (2.0 * s - 1.0).abs())
-            }
-            FootCycle::Enhanced { overlap } => {
-                let rate = o.lift / (1.5 * overlap);
-                (rate * (phi - (beta + overlap / 2.0)).min((1.0 - overlap / 2.0) - phi)).max(0.0)
-            }
-        }
+        let (from, to) = match o.cycle {
+            FootCycle::Plain => (beta, 1.0),
+            FootCycle::Enhanced { overlap } => (beta + overlap / 2.0, 1.0 - overlap / 2.0),
+        };
+        let s = ((phi - from) / (to - from)).clamp(0.0, 1.0);
+        o.lift * (1.0 - (2.0 * s - 1.0).abs())
     }
 
     fn current_pattern(&self) -> &GaitPattern {
@@ -252,13 +250,20 @@ impl Controller for GaitController {
                     next.swing_xy = next.swing_from;
                     next.aep = self.aep(l, &frame_desired, &body, support_foot.z);
                 }
-                // Touching down: the anchor (virtual AEP of the landing, Section 7.6) where the
-                // foot reference is, seen with the estimated body pose.
-                (FootPhase::Swing, FootPhase::Landing | FootPhase::Support) => {
+                // Landing: the virtual AEP of Section 7.6 where the foot reference is, seen with
+                // the estimated body pose, so that the support algorithm runs during the landing.
+                (FootPhase::Swing, FootPhase::Landing) => {
                     let mut foot = leg.swing_xy;
                     foot.z = support_foot.z;
                     next.anchor = frame_estimated.apply(&foot);
                     next.anchor.z = leg.anchor.z;
+                }
+                // Touchdown, the beginning of the support (Section 7.4): the anchor is where the
+                // encoders put the foot, seen with the estimated body pose, at the support level,
+                // so that the legs on the ground do not fight each other.
+                (FootPhase::Swing | FootPhase::Landing, FootPhase::Support) => {
+                    let measured = frame_estimated.apply(&self.legs_kinematics[l].foot(&joints_of(m, l)));
+                    next.anchor = Vector3::new(measured.x, measured.y, leg.anchor.z);
                 }
                 _ => {}
             }
