@@ -58,10 +58,13 @@ struct Leg {
 }
 
 /// Counters of what went wrong, for reports and tests.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GaitDiagnostics {
-    /// Foot references the inverse kinematics had to clamp into the joint ranges.
+    /// Foot references the inverse kinematics had to clamp into the joint ranges, and the last
+    /// instant it happened (the first step starts from the workspace centres, so its stroke is
+    /// not centred, Section 7.5.1, and may overrun at high velocities).
     pub clamped_references: usize,
+    pub last_clamped_at: Option<f64>,
     pub gait_switches: usize,
 }
 
@@ -302,6 +305,7 @@ impl Controller for GaitController {
             let ik = self.legs_kinematics[l].inverse(&next.foot, &leg.joints).expect("finite foot reference");
             if !ik.is_reached() {
                 self.diagnostics.clamped_references += 1;
+                self.diagnostics.last_clamped_at = Some(m.t);
             }
             next.joints = ik.joints;
             self.legs[l] = next;
