@@ -1,0 +1,76 @@
+//! Gait benchmark: one controller update (desired body motion, gait phases, inverse kinematics
+//! of the 6 legs, 18 PI) in median ns, quoted against the 10 ms control period; and the thesis'
+//! simulation-time case (Section 3.4.1: tripod, T = 15 s, V_x = 2 cm/s, 75 s, LuGre) end to
+//! end, quoted as wall time and real-time factor against the thesis' 260 s (Table 3.2).
+
+use std::hint::black_box;
+use std::sync::Arc;
+use std::time::Instant;
+
+use hexadyn::control::gait::controller::{AepMode, GaitController, GaitOptions};
+use hexadyn::control::gait::heading::{Constant, Heading};
+use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
+use hexadyn::control::{Controller, DigitalPi, LegKinematics, Measurements, JOINTS};
+use hexadyn::physics::FlatGround;
+use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
+use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
+use hexadyn::robot::{Joint, RobotDescription};
+use nalgebra::Vector3;
+
+const THESIS_WALL_S: f64 = 260.0;
+
+fn controller(d: &RobotDescription, period: f64, vx: f64) -> (GaitController, [f64; JOINTS]) {
+    let legs = LegKinematics::hexapod_from_description(d).unwrap();
+    let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
+    let lift = 0.045;
+    let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
+    let mut joints = [0.0; JOINTS];
+    for l in 0..6 {
+        let ik = legs[l].inverse(&workspaces[l].centre_at(-height), &Vector3::new(0.0, 0.06, 0.03)).unwrap();
+        joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
+    }
+    let pis = std::array::from_fn(|k| {
+        let g = d.pi_gains(Joint::ALL[k % 3]);
+        DigitalPi::new(g.k, g.t_i, d.controller.period_s)
+    });
+    let options = GaitOptions { period, pattern: GaitPattern::tripod(), cycle: FootCycle::Enhanced { overlap: 0.05 }, aep: AepMode::Omnidirectional, lift, dt: d.controller.period_s };
+    (GaitController::new(options, legs, workspaces, pis, Box::new(Constant(Heading::new(vx, 0.0, 0.0)))), joints)
+}
+
+fn main() {
+    let d = RobotDescription::amru5();
+    // One controller update, open loop on measurements that follow the references.
+    let (mut c, joints) = controller(&d, 12.0, 0.015);
+    let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None };
+    let mut samples = Vec::new();
+    for i in 0..30_000 {
+        m.t = i as f64 * 0.01;
+        let start = Instant::now();
+        let command = black_box(c.update(black_box(&m)));
+        samples.push(start.elapsed().as_nanos() as f64);
+        m.positions = command.references;
+    }
+    samples.sort_by(f64::total_cmp);
+    let median = samples[samples.len() / 2];
+    println!("hexadyn gait benchmark");
+    println!("  controller update (body motion, gait, IK x 6, 18 PI)  median {median:>8.0} ns, p99 {:>8.0} ns = {:.4} % of the 10 ms period", samples[samples.len() * 99 / 100], median / 1e7 * 100.0);
+
+    // The simulation-time case of Section 3.4.1.
+    let (mut c, joints) = controller(&d, 15.0, 0.02);
+    let model = Arc::new(RobotModel::new(&d, ModelOptions::from_description(&d, FrictionModel::LuGre), Arc::new(FlatGround { height: 0.0 })));
+    let q = model.touching_ground(&joints);
+    let qd = vec![0.0; q.len()];
+    let start = Instant::now();
+    let mut plant = SimulatedRobot::new(model, &q, &qd, &PlantOptions::from_description(&d)).unwrap();
+    run(&mut plant, &mut c, 75.0, |_, _, _| {}).unwrap();
+    let wall = start.elapsed().as_secs_f64();
+    let s = plant.integrator.stats();
+    println!(
+        "  75 s tripod walk, T = 15 s, V_x = 2 cm/s, LuGre (Section 3.4.1)   wall {wall:.2} s, real-time factor {:.1}; thesis {THESIS_WALL_S} s: {:.0}x faster ({} steps, {} Jacobians, {} LU)",
+        75.0 / wall,
+        THESIS_WALL_S / wall,
+        s.steps,
+        s.jacobian_evaluations,
+        s.factorizations
+    );
+}
