@@ -321,6 +321,6 @@ fn settling_failures_are_reported() {
     let s = parse(&with("stand_three_legs", "lifted_legs = [1, 2, 5]", "lifted_legs = [0, 2, 4]")).unwrap();
     let e = run_scenario(&s, |_| {}).unwrap_err();
     let m = e.to_string();
-    assert!(matches!(e, ScenarioError::Simulation { .. }), "{m}");
+    assert!(matches!(e, ScenarioError::Simulation { .. } | ScenarioError::Tipped { .. }), "{m}");
     assert!(m.starts_with("bad.toml: settling") && m.contains("initial.lifted_legs") && !m.contains('\n'), "{m}");
 }

@@ -273,12 +273,94 @@ pub struct Robot {
     /// Joint references (inputs with continuous PID control, rad or m).
     pub references: [f64; JOINTS],
     pub outputs: Outputs,
+    /// The slowly varying part of the Jacobian (see [`Robot::jacobian`]) and where it was taken.
+    inertial: Option<InertialJacobian>,
+}
+
+/// ∂/∂q and ∂/∂q' of the multibody rows with the contact forces and joint forces held at their
+/// values (inertia, gravity and the geometry of the points the forces act at), and the
+/// derivatives of the foot velocities with respect to q, by central differences.
+#[derive(Clone, Debug)]
+struct InertialJacobian {
+    q: Vec<f64>,
+    kt: DMatrix<f64>,
+    ct: DMatrix<f64>,
+    /// ∂v_foot/∂q per foot (3 × 24).
+    dv_dq: Vec<nalgebra::Matrix3xX<f64>>,
+}
+
+impl InertialJacobian {
+    /// Whether the configuration moved little enough since it was taken: 1 mm or 1 mrad on the
+    /// body, 1 mrad on q_r, 0.1 mm on the nuts (amplified about 7 times at the foot).
+    fn holds_at(&self, q: &[f64]) -> bool {
+        (0..DOF).all(|i| {
+            let tolerance = match i {
+                0..=5 => 1e-3,
+                _ if (i - 6) % 3 == 0 => 1e-3,
+                _ => 1e-4,
+            };
+            (q[i] - self.q[i]).abs() <= tolerance
+        })
+    }
 }
 
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
-        Robot { model, data, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default() }
+        Robot { model, data, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None }
+    }
+
+    /// Multibody rows with the contact and joint forces frozen at `contact` and `joint`
+    /// (generalized joint forces), and the foot velocities.
+    fn frozen_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], contact: &[Vector3<f64>; 6], joint: &[f64; JOINTS], f: &mut [f64], feet: &mut [Vector3<f64>; 6]) {
+        let mech = &self.model.mechanics;
+        mbs::kinematics(&mech.model, &mut self.data, &q[..DOF], &qd[..DOF]);
+        self.data.clear_forces();
+        for (leg, bodies) in mech.legs.iter().enumerate() {
+            let p = self.data.point(bodies.links[3], &mech.foot_local);
+            feet[leg] = self.data.point_velocity(bodies.links[3], &p);
+            self.data.add_force(bodies.links[3], &p, &contact[leg]);
+        }
+        for (k, tau) in joint.iter().enumerate() {
+            self.data.add_generalized_force(6 + k, *tau);
+        }
+        mbs::residual(&mech.model, &self.data, &qdd[..DOF], &mut f[..DOF]);
+    }
+
+    /// Central differences of [`Self::frozen_residual`] over q and q' (Eq. 3.12).
+    fn inertial_jacobian(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) -> InertialJacobian {
+        self.evaluate(q, qd, qdd);
+        let contact = self.outputs.contact.map(|c| c.force);
+        let joint: [f64; JOINTS] = std::array::from_fn(|k| self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
+        let scales = self.model.layout.scales.clone();
+        let mut jac = InertialJacobian { q: q.to_vec(), kt: DMatrix::zeros(DOF, DOF), ct: DMatrix::zeros(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6] };
+        let (mut fp, mut fm) = (vec![0.0; DOF], vec![0.0; DOF]);
+        let (mut vp, mut vm) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
+        let (mut x, mut xd) = (q.to_vec(), qd.to_vec());
+        for j in 0..DOF {
+            let step = 1e-6 * x[j].abs().max(1e3 * scales[j]);
+            x[j] = q[j] + step;
+            self.frozen_residual(&x, qd, qdd, &contact, &joint, &mut fp, &mut vp);
+            x[j] = q[j] - step;
+            self.frozen_residual(&x, qd, qdd, &contact, &joint, &mut fm, &mut vm);
+            x[j] = q[j];
+            for i in 0..DOF {
+                jac.kt[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+            }
+            for leg in 0..6 {
+                jac.dv_dq[leg].set_column(j, &((vp[leg] - vm[leg]) / (2.0 * step)));
+            }
+            let step = 1e-6 * xd[j].abs().max(1e2 * scales[j]);
+            xd[j] = qd[j] + step;
+            self.frozen_residual(q, &xd, qdd, &contact, &joint, &mut fp, &mut vp);
+            xd[j] = qd[j] - step;
+            self.frozen_residual(q, &xd, qdd, &contact, &joint, &mut fm, &mut vm);
+            xd[j] = qd[j];
+            for i in 0..DOF {
+                jac.ct[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+            }
+        }
+        jac
     }
 
     /// Holds a command for the next control period. Digital control: the voltages, cut by the
@@ -401,32 +483,75 @@ impl System for Robot {
     /// of the whole residual (contact, inertia and joint forces depend on them through the
     /// kinematics).
     fn jacobian(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], jac: &mut Jacobian) -> bool {
-        let n = q.len();
-        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-        let (mut x, mut xd) = (q.to_vec(), qd.to_vec());
-        let scales = self.model.layout.scales.clone();
-        for j in 0..DOF {
-            let step = 1e-6 * x[j].abs().max(1e3 * scales[j]);
-            x[j] = q[j] + step;
-            self.write_residual(&x, qd, qdd, &mut fp);
-            x[j] = q[j] - step;
-            self.write_residual(&x, qd, qdd, &mut fm);
-            x[j] = q[j];
-            for i in 0..n {
-                jac.kt[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
-            }
-            let step = 1e-6 * xd[j].abs().max(1e2 * scales[j]);
-            xd[j] = qd[j] + step;
-            self.write_residual(q, &xd, qdd, &mut fp);
-            xd[j] = qd[j] - step;
-            self.write_residual(q, &xd, qdd, &mut fm);
-            xd[j] = qd[j];
-            for i in 0..n {
-                jac.ct[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
-            }
+        // The inertial part is re-taken only when the configuration has moved (modified Newton
+        // already tolerates an approximate Jacobian; the contact and joint terms, which carry
+        // the fast and non-smooth changes, are exact at every call).
+        if !self.inertial.as_ref().is_some_and(|c| c.holds_at(q)) {
+            self.inertial = Some(self.inertial_jacobian(q, qd, qdd));
         }
         self.evaluate(q, qd, qdd);
         self.write_mass_matrix(qd, qdd, &mut jac.m);
+        let inertial = self.inertial.as_ref().expect("taken above");
+        jac.kt.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.kt);
+        jac.ct.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.ct);
+        let m = &*self.model;
+        let mech = &m.mechanics;
+        // Contact (Eq. 3.72-3.73): f contains −J_footᵀ F, F(p(q), v(q, q')).
+        let mut dfn_dq = [nalgebra::RowSVector::<f64, DOF>::zeros(); 6];
+        let mut dfn_dqd = [nalgebra::RowSVector::<f64, DOF>::zeros(); 6];
+        for (leg, bodies) in mech.legs.iter().enumerate() {
+            let c = &self.outputs.contact[leg];
+            if c.df_dp == nalgebra::Matrix3::zeros() && c.df_dv == nalgebra::Matrix3::zeros() {
+                continue;
+            }
+            let mut j_foot = nalgebra::SMatrix::<f64, 3, DOF>::zeros();
+            for (col, d) in self.data.point_partial_velocities(&mech.model, bodies.links[3], &self.outputs.foot[leg]) {
+                j_foot.set_column(col, &d);
+            }
+            let df_dq = c.df_dp * j_foot + c.df_dv * &inertial.dv_dq[leg];
+            let df_dqd = c.df_dv * j_foot;
+            let kt = -j_foot.transpose() * df_dq;
+            let ct = -j_foot.transpose() * df_dqd;
+            let mut block = jac.kt.view_mut((0, 0), (DOF, DOF));
+            block += kt;
+            let mut block = jac.ct.view_mut((0, 0), (DOF, DOF));
+            block += ct;
+            // The normal force (the leg load of Eq. 5.12): F_n = n·F.
+            let normal = m.terrain.height_normal(self.outputs.foot[leg].x, self.outputs.foot[leg].y).1;
+            dfn_dq[leg] = normal.transpose() * df_dq;
+            dfn_dqd[leg] = normal.transpose() * df_dqd;
+        }
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            let leg = k / 3;
+            let load = self.outputs.contact[leg].normal_force;
+            let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
+            // f_j contains −τ_m + τ_f.
+            let t = m.friction[k].torque(qd[j], z, zdot, load);
+            let motor = &m.motors[k];
+            let dtau_m = if m.currents.is_some() { 0.0 } else { motor.joint_torque(motor.current(qd[j], 0.0).di_dqd).0 };
+            jac.ct[(j, j)] += t.dtau_dqd - dtau_m;
+            for col in 0..DOF {
+                jac.kt[(j, col)] += t.dtau_dload * dfn_dq[leg][col];
+                jac.ct[(j, col)] += t.dtau_dload * dfn_dqd[leg][col];
+            }
+            if let Some(b) = m.bristles {
+                let r = m.friction[k].bristle_residual(qd[j], z, zdot, load).expect("LuGre has a bristle state");
+                jac.ct[(b + k, j)] = r.df_dqd;
+                for col in 0..DOF {
+                    jac.kt[(b + k, col)] += r.df_dload * dfn_dq[leg][col];
+                    jac.ct[(b + k, col)] += r.df_dload * dfn_dqd[leg][col];
+                }
+            }
+            if let Some(c) = m.currents {
+                jac.ct[(c + k, j)] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).df_dqd;
+            }
+            if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
+                let i = p + 2 * k + 1;
+                // ε = q_d − q_j.
+                jac.kt[(i, j)] = -pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).df_depsilon;
+            }
+        }
         let m = &*self.model;
         for k in 0..JOINTS {
             let j = 6 + k;

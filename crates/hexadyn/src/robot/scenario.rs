@@ -132,6 +132,10 @@ pub enum ScenarioError {
     /// cause.
     #[error("{file}: {stage} failed: {source}{hint}")]
     Simulation { file: String, stage: &'static str, source: SimError, hint: &'static str },
+    /// The settled body tilts by more than 5°: the stance cannot carry it (it rests on lifted
+    /// legs).
+    #[error("{file}: settling tips the body over (pitch {pitch_deg:.1}°, roll {roll_deg:.1}°); check that the supporting feet surround the centre of mass (initial.lifted_legs)")]
+    Tipped { file: String, pitch_deg: f64, roll_deg: f64 },
     /// The progress callback asked to stop.
     #[error("{file}: stopped at t = {t:.3} s")]
     Stopped { file: String, t: f64 },
@@ -776,6 +780,10 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
             source,
             hint: "; check that the supporting feet surround the centre of mass (initial.lifted_legs)",
         })?;
+        let (pitch, roll) = (q[4].to_degrees(), q[5].to_degrees());
+        if pitch.abs() > 5.0 || roll.abs() > 5.0 {
+            return Err(ScenarioError::Tipped { file: s.origin.clone(), pitch_deg: pitch, roll_deg: roll });
+        }
     }
     q[2] += s.initial.body_height_offset;
 

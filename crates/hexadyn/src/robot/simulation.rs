@@ -120,7 +120,7 @@ pub struct PlantOptions {
 impl PlantOptions {
     pub fn from_description(d: &RobotDescription) -> Self {
         PlantOptions {
-            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, slow_contraction: 0.9, ..Default::default() },
+            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, slow_contraction: 0.9, gamma: 0.6, beta: 0.3025, ..Default::default() },
             period: d.controller.period_s,
             encoder_counts: d.controller.encoder_impulses_per_rev,
             navigation: false,

@@ -74,8 +74,21 @@ pub fn static_equilibrium<S: System + ?Sized>(
                 };
             }
         }
-        let Some(dx) = a.lu().solve(&rhs) else {
-            return Err(SimError::Singular { what: "static tangent stiffness", t });
+        // A tangent stiffness that vanishes in some direction (a foot just touching the
+        // ground, Eq. 3.72 with δ = 0) is regularized Levenberg-Marquardt style: the backtracking
+        // below then takes the useful fraction of the step.
+        let scale = (0..k).map(|i| a[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let mut damping = 0.0;
+        let dx = loop {
+            let mut damped = a.clone();
+            for i in 0..k {
+                damped[(i, i)] += damping;
+            }
+            match damped.lu().solve(&rhs) {
+                Some(dx) if dx.iter().all(|x| x.is_finite()) => break dx,
+                _ if damping < scale => damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 },
+                _ => return Err(SimError::Singular { what: "static tangent stiffness", t }),
+            }
         };
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
         let mut lambda = 1.0;
