@@ -52,6 +52,13 @@ impl Htm {
 pub fn rotation_about(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
     let (s, c) = angle.sin_cos();
     let (x, y, z) = (axis.x, axis.y, axis.z);
+    // The unit axes of Eq. A.2-A.4 directly.
+    match (x == 1.0, y == 1.0, z == 1.0) {
+        (true, _, _) => return Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c),
+        (_, true, _) => return Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c),
+        (_, _, true) => return Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+        _ => {}
+    }
     let v = 1.0 - c;
     Matrix3::new(
         c + x * x * v,

@@ -275,15 +275,16 @@ impl ModelBuilder {
             let pos = |c: usize| columns.binary_search(&c).expect("column present");
             let parent_columns = spec.parent.map(|p| bodies[p.0].columns.iter().map(|&c| pos(c)).collect()).unwrap_or_default();
             let compile = |var: &Var| CompiledVar { var: *var, columns: self.source_inputs(var.source).into_iter().map(pos).collect() };
-            let joint = spec
-                .joint
-                .iter()
-                .map(|e| match e {
-                    Elementary::Fixed(h) => CompiledElementary::Fixed(*h),
-                    Elementary::Rotation { axis, var } => CompiledElementary::Rotation { axis: *axis, var: compile(var) },
-                    Elementary::Translation { axis, var } => CompiledElementary::Translation { axis: *axis, var: compile(var) },
-                })
-                .collect();
+            // Consecutive constant HTMs are multiplied once here rather than at every evaluation.
+            let mut joint: Vec<CompiledElementary> = Vec::with_capacity(spec.joint.len());
+            for e in &spec.joint {
+                match (e, joint.last_mut()) {
+                    (Elementary::Fixed(h), Some(CompiledElementary::Fixed(previous))) => *previous = previous.compose(h),
+                    (Elementary::Fixed(h), _) => joint.push(CompiledElementary::Fixed(*h)),
+                    (Elementary::Rotation { axis, var }, _) => joint.push(CompiledElementary::Rotation { axis: *axis, var: compile(var) }),
+                    (Elementary::Translation { axis, var }, _) => joint.push(CompiledElementary::Translation { axis: *axis, var: compile(var) }),
+                }
+            }
             let n = columns.len();
             bodies.push(Body {
                 name: spec.name.clone(),
