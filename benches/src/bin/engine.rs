@@ -17,7 +17,7 @@ fn hexapod_tree() -> Model {
         .add_body(BodySpec {
             name: "body".into(),
             parent: None,
-            joint: vec![Elementary::tx(Var::q(0)), Elementary::ty(Var::q(1)), Elementary::tz(Var::q(2)), Elementary::rz(Var::q(3)), Elementary::ry(Var::q(4)), Elementary::rx(Var::q(5))],
+            joint: Elementary::free_body(0),
             mass: 11.2,
             inertia: Matrix3::from_diagonal(&Vector3::new(0.1063, 0.1198, 0.0843)),
         })

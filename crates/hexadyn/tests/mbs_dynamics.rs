@@ -4,7 +4,7 @@
 mod mbs_models;
 
 use approx::assert_relative_eq;
-use hexadyn::mbs::{generalized_forces, kinematics, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, BodySpec, Data, Elementary, Model, ModelBuilder, MultibodySystem, Var};
+use hexadyn::mbs::{generalized_forces, kinematics, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, BodySpec, Data, Elementary, Model, ModelBuilder, MultibodySystem};
 use hexadyn::sim::{Newmark, NewmarkOptions};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
@@ -62,7 +62,7 @@ fn free_body(gravity: bool) -> Model {
     b.add_body(BodySpec {
         name: "body".into(),
         parent: None,
-        joint: vec![Elementary::tx(Var::q(0)), Elementary::ty(Var::q(1)), Elementary::tz(Var::q(2)), Elementary::rz(Var::q(3)), Elementary::ry(Var::q(4)), Elementary::rx(Var::q(5))],
+        joint: Elementary::free_body(0),
         mass: 11.2,
         inertia: Matrix3::from_diagonal(&Vector3::new(0.1063, 0.1198, 0.0843)),
     })

@@ -80,6 +80,18 @@ impl Elementary {
     pub fn tz(var: Var) -> Self {
         Elementary::Translation { axis: Vector3::z(), var }
     }
+    /// A free body on the six coordinates from `first`: T^d(X, Y, Z) T^Rz(Φ) T^Ry(Θ) T^Rx(Ψ)
+    /// (yaw, pitch, roll; Eq. 3.52).
+    pub fn free_body(first: usize) -> Vec<Self> {
+        vec![
+            Elementary::tx(Var::q(first)),
+            Elementary::ty(Var::q(first + 1)),
+            Elementary::tz(Var::q(first + 2)),
+            Elementary::rz(Var::q(first + 3)),
+            Elementary::ry(Var::q(first + 4)),
+            Elementary::rx(Var::q(first + 5)),
+        ]
+    }
 }
 
 /// What the user gives for one body.

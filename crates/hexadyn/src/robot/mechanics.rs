@@ -90,7 +90,7 @@ impl Mechanics {
         let body = b.add_body(BodySpec {
             name: "body".into(),
             parent: None,
-            joint: vec![Elementary::tx(Var::q(0)), Elementary::ty(Var::q(1)), Elementary::tz(Var::q(2)), Elementary::rz(Var::q(3)), Elementary::ry(Var::q(4)), Elementary::rx(Var::q(5))],
+            joint: Elementary::free_body(0),
             mass: p.body.mass,
             inertia: p.body.tensor(),
         })?;

@@ -11,7 +11,7 @@ pub fn tree() -> Model {
         .add_body(BodySpec {
             name: "base".into(),
             parent: None,
-            joint: vec![Elementary::tx(Var::q(0)), Elementary::ty(Var::q(1)), Elementary::tz(Var::q(2)), Elementary::rz(Var::q(3)), Elementary::ry(Var::q(4)), Elementary::rx(Var::q(5))],
+            joint: Elementary::free_body(0),
             mass: 10.0,
             inertia: Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.25)),
         })
