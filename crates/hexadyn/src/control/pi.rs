@@ -50,7 +50,8 @@ pub struct Encoder {
 
 impl Encoder {
     /// The AMRU5 encoder (500 counts per revolution) on a motor of reduction `n`.
-    pub fn amru5(n: f64) -> Self {
+    #[cfg(test)]
+    fn amru5(n: f64) -> Self {
         Encoder { counts_per_rev: 500, n }
     }
 

@@ -67,6 +67,7 @@ pub struct GroundContact {
     pub v_glim: f64,
 }
 
+#[cfg(test)]
 impl Default for GroundContact {
     /// Table 3.3.
     fn default() -> Self {

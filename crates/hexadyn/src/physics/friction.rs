@@ -21,14 +21,20 @@
 
 use serde::{Deserialize, Serialize};
 
+// AMRU5 values of the thesis, for the unit tests of this module only: the engine takes every
+// parameter from the robot description (robots/amru5.toml).
 /// Half width ε of the linear zone of Eq. 6.1 (rad/s or m/s), Section 6.1.
-pub const LINEAR_ZONE: f64 = 1e-4;
+#[cfg(test)]
+const LINEAR_ZONE: f64 = 1e-4;
 /// Bristle stiffness σ0 of Table 6.1 (Nm/rad or N/m; the table's "1e-9" lost its sign).
-pub const BRISTLE_STIFFNESS: f64 = 1e9;
+#[cfg(test)]
+const BRISTLE_STIFFNESS: f64 = 1e9;
 /// Bristle damping σ1 of Table 6.1 (Nms/rad or Ns/m).
-pub const BRISTLE_DAMPING: f64 = 0.02;
+#[cfg(test)]
+const BRISTLE_DAMPING: f64 = 0.02;
 /// Stribeck velocity q'_st of the vertical joints, Table 6.1 (m/s).
-pub const STRIBECK_VELOCITY: f64 = 1e-4;
+#[cfg(test)]
+const STRIBECK_VELOCITY: f64 = 1e-4;
 /// Weight of one kilogram (N/kg): the foot loads of Section 5.4 are masses hung at the foot
 /// (Section 5.3 uses 9.81 m/s²), so a load force F enters Eq. 5.12 as x = F / LOAD_GRAVITY kg.
 pub const LOAD_GRAVITY: f64 = 9.81;
@@ -71,9 +77,10 @@ pub struct DryViscous {
 }
 
 impl DryViscous {
-    /// Eq. 6.1 with ε = [`LINEAR_ZONE`], from the identified parameters of Table 5.3; negative
+    /// Eq. 6.1 with ε = LINEAR_ZONE, from the identified parameters of Table 5.3; negative
     /// (non-physical) viscous coefficients are forced to zero as in Section 6.1.
-    pub fn new(tau_d_pos: f64, tau_d_neg: f64, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
+    #[cfg(test)]
+    fn new(tau_d_pos: f64, tau_d_neg: f64, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
         let law = DryViscous { tau_d_pos, tau_d_neg, f_v_pos: f_v_pos.max(0.0), f_v_neg: f_v_neg.max(0.0), epsilon: LINEAR_ZONE };
         law.validate()?;
         Ok(law)
@@ -201,7 +208,8 @@ impl LuGre {
     /// The LuGre law with σ0, σ1 of Table 6.1 and v_d = q'_st of Table 6.1 (Olsson's choice of
     /// v_d "in relation to the Stribeck velocity", Section 3.4.3; the thesis gives no value).
     /// Negative (non-physical) viscous coefficients are forced to zero as in Section 6.1.
-    pub fn new(steady: SteadyState, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
+    #[cfg(test)]
+    fn new(steady: SteadyState, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
         let law = LuGre {
             sigma_0: BRISTLE_STIFFNESS,
             sigma_1: BRISTLE_DAMPING,

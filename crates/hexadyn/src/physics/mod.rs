@@ -12,6 +12,6 @@ mod motor;
 pub use contact::{ContactForce, FlatGround, GroundContact, Slope, Terrain};
 pub use friction::{
     BristleResidual, DryViscous, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,
-    BRISTLE_DAMPING, BRISTLE_STIFFNESS, LINEAR_ZONE, LOAD_GRAVITY, STRIBECK_VELOCITY,
+    LOAD_GRAVITY,
 };
-pub use motor::{limit_switch, saturate, Current, CurrentResidual, DcMotor, H_BRIDGE_RESISTANCE};
+pub use motor::{limit_switch, saturate, Current, CurrentResidual, DcMotor};

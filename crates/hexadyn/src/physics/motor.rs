@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 
 /// Series resistance of the H-bridge, 2 × 0.3 Ω (two conducting MOSFETs of the LMD18200,
 /// Section 6.4).
-pub const H_BRIDGE_RESISTANCE: f64 = 0.6;
+#[cfg(test)]
+const H_BRIDGE_RESISTANCE: f64 = 0.6;
 
 /// A permanent-magnet DC motor driving one joint through a reduction n (Eq. 3.88-3.92).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -56,7 +57,8 @@ impl DcMotor {
     /// The Maxon RE35 of Table 3.4 (R = 0.334 Ω, L = 0.09 mH, k_t = 19.4e-3 Nm/A) behind the
     /// H-bridge of Section 6.4, with the reduction `n` of its joint (Fig. 2.16, Table 3.1) and
     /// the inductance neglected (Section 4.5).
-    pub fn re35(n: f64) -> Self {
+    #[cfg(test)]
+    fn re35(n: f64) -> Self {
         DcMotor { r: 0.334, r_bridge: H_BRIDGE_RESISTANCE, l: 0.09e-3, k_t: 19.4e-3, n, inductance: false }
     }
 
