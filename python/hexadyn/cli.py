@@ -14,9 +14,9 @@ import click
 import hexadyn
 
 #: Scenario run by `hexadyn simulate` without an argument (and by `make run`): a shipped scenario
-#: name or a path. For now the robot standing on six legs; switch it to the walking validation
-#: case (Table 6.2) once that scenario exists.
-DEFAULT_SCENARIO = "stand_six_legs"
+#: name or a path. The validation test case of Table 6.2 (tripod, T = 12 s, 5 steps, 5 % overlap)
+#: at V_x = 1.5 cm/s with LuGre friction: 60 s of walking.
+DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 
 #: Folder under which `hexadyn simulate` writes results when no --out is given.
 RESULTS_ROOT = Path("results")
@@ -95,6 +95,15 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
         f"friction {s['energy_friction_j']:.4g} J, balance error {s['energy_balance_error_j']:.3g} J"
     )
     click.echo(f"  voltages    max |u| {s['max_abs_voltage_v']:.2f} V, saturated {100 * s['saturated_fraction']:.2f} % of commands, {s['limit_switch_cuts']} limit-switch cuts")
+    if "tracking_error_xy_max_m" in s:
+        click.echo(
+            f"  walking     {s['distance_walked_m']:.3f} m walked (reference {s['reference_distance_m']:.3f} m), "
+            f"XY tracking error max {s['tracking_error_xy_max_m'] * 1e3:.2f} mm, final {s['tracking_error_xy_final_m'] * 1e3:.2f} mm"
+        )
+        click.echo(
+            f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
+            f"at least {s['min_feet_on_ground']} feet on the ground"
+        )
 
 
 @cli.command()

@@ -27,6 +27,20 @@ SHIPPED = {
     "leg_ramp",
     "leg_sine",
     "leg_sawtooth",
+    "validation_tripod_1cm",
+    "validation_tripod_1_5cm",
+    "validation_tripod_2cm",
+    "validation_tripod_2_5cm",
+    "simulation_time",
+    "path_back_and_forth",
+    "path_back_and_forth_no_navigation",
+    "path_straight_lines",
+    "path_straight_lines_no_navigation",
+    "path_spline",
+    "path_spline_no_navigation",
+    "soft_ground_enhanced",
+    "soft_ground_plain",
+    "gait_changes",
 }
 
 
@@ -214,6 +228,57 @@ def test_unpowered_scenario_columns(tmp_path: Path):
     assert "z_q_v[0]" not in r.timeseries.columns  # no bristles without LuGre
     assert (r.timeseries["u_q_v[0]"] == 0).all()
     assert r.summary["control"] == "unpowered" and r.summary["friction"] == "none"
+
+
+def test_walking_scenario(tmp_path: Path):
+    """A shortened validation walk (Table 6.2 at 1.5 cm/s): the gait columns in pandas."""
+    path = shortened("validation_tripod_1_5cm", tmp_path, 2.0)
+    info = _core.load_scenario(str(path))
+    assert info["control"] == "gait"
+    assert info["gait"] == {
+        "pattern": "tripod",
+        "period_s": 12.0,
+        "duty_factor": 0.5,
+        "cycle": "enhanced",
+        "heading": "constant",
+        "navigation": False,
+        "clearance_m": 0.045,
+        "body_height_m": pytest.approx(0.414, abs=1e-3),
+        "changes": 0,
+    }
+    assert _core.load_scenario(str(hexadyn.SCENARIOS_DIR / "leg_sine.toml"))["gait"] is None
+
+    r = hexadyn.simulate(path, progress=False)
+    df = r.timeseries
+    assert len(df) == 201
+    for name, unit in {"X_ref": "m", "Y_ref": "m", "yaw_ref": "rad", "X_dot_ref": "m/s", "phase[1]": "1", "foot_ref_z[1]": "m", "duty_factor": "1"}.items():
+        assert name in df.columns and r.units[name] == unit, name
+    assert df["X_ref"].iloc[-1] == pytest.approx(0.015 * 1.995, abs=1e-9)
+    assert (df["Y_ref"] == 0).all()
+    assert (df["X"] - df["X_ref"]).abs().max() < 2e-3
+    # Tripod {1, 2, 5} lifts off (support, takeoff, swing); {0, 3, 4} stays down.
+    assert set(df["phase[1]"].unique()) == {0.0, 1.0, 2.0}
+    assert (df["phase[0]"] == 0).all()
+    s = r.summary
+    assert s["control"] == "gait" and s["gait_pattern"] == "tripod" and s["navigation"] == "false"
+    assert s["tracking_error_xy_max_m"] < 2e-3
+    assert s["reference_distance_m"] == pytest.approx(0.015 * 1.995, abs=1e-6)
+    assert s["gait_switches"] == 0 and s["clamped_ik_references"] == 0 and s["min_feet_on_ground"] == 3
+
+    result = CliRunner().invoke(cli, ["simulate", str(path), "--out", str(tmp_path / "walk"), "--no-progress"], prog_name="hexadyn")
+    assert result.exit_code == 0, result.output
+    assert "XY tracking error" in result.output and "gait switches" in result.output
+
+
+def test_walking_scenario_errors(tmp_path: Path):
+    bad = tmp_path / "bad.toml"
+    text = (hexadyn.SCENARIOS_DIR / "validation_tripod_1_5cm.toml").read_text()
+    bad.write_text(text.replace("vx_m_s = 0.015", "vx_m_s = 0.05"))
+    with pytest.raises(ValueError, match=r"bad\.toml:\d+: field `gait\.heading` = .*does not fit the workspace"):
+        _core.load_scenario(str(bad))
+    bad.write_text(text.replace('pattern = "tripod"', 'pattern = "gallop"'))
+    with pytest.raises(ValueError, match=r"gait\.pattern.*gallop.*tripod"):
+        hexadyn.simulate(bad, progress=False)
 
 
 # ---------------------------------------------------------------------------------------------

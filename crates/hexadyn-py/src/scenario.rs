@@ -22,7 +22,9 @@ fn load(path: &PathBuf) -> PyResult<Scenario> {
 
 /// Reads and validates a scenario file without running it. Returns a dict with "name",
 /// "description", "duration_s", "friction", "control", "robot" (`"amru5"` or the robot file),
-/// "lifted_legs" and "motions" (their count). Raises ValueError on an invalid scenario.
+/// "lifted_legs", "motions" (their count) and "gait" (None, or in gait mode a dict with
+/// "pattern", "period_s", "duty_factor", "cycle", "heading", "navigation", "clearance_m",
+/// "body_height_m" and "changes", their count). Raises ValueError on an invalid scenario.
 #[pyfunction]
 pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let s = load(&path)?;
@@ -35,6 +37,25 @@ pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py,
     d.set_item("robot", &s.robot_source)?;
     d.set_item("lifted_legs", s.initial.lifted_legs.clone())?;
     d.set_item("motions", s.motions.len())?;
+    match &s.gait {
+        None => d.set_item("gait", py.None())?,
+        Some(g) => {
+            let gd = PyDict::new(py);
+            gd.set_item("pattern", &g.options.pattern.name)?;
+            gd.set_item("period_s", g.options.period)?;
+            gd.set_item("duty_factor", g.options.pattern.beta)?;
+            gd.set_item("cycle", match g.options.cycle {
+                hexadyn::control::gait::pattern::FootCycle::Plain => "plain",
+                hexadyn::control::gait::pattern::FootCycle::Enhanced { .. } => "enhanced",
+            })?;
+            gd.set_item("heading", g.heading.kind())?;
+            gd.set_item("navigation", g.navigation)?;
+            gd.set_item("clearance_m", g.options.lift)?;
+            gd.set_item("body_height_m", g.body_height)?;
+            gd.set_item("changes", g.changes.len())?;
+            d.set_item("gait", gd)?;
+        }
+    }
     Ok(d)
 }
 

@@ -4,7 +4,10 @@
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-use hexadyn::robot::scenario::{run_scenario, run_scenario_until, ControlMode, Scenario, ScenarioError};
+use hexadyn::control::gait::controller::AepMode;
+use hexadyn::control::gait::pattern::FootCycle;
+use hexadyn::robot::model::FrictionModel;
+use hexadyn::robot::scenario::{run_scenario, run_scenario_until, ControlMode, HeadingSpec, Scenario, ScenarioError};
 use hexadyn::robot::{Joint, AMRU5_TOML};
 
 fn scenarios_dir() -> PathBuf {
@@ -36,7 +39,30 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 8] = ["stand_six_legs", "stand_three_legs", "unpowered_none", "unpowered_dry_viscous", "unpowered_lugre", "leg_ramp", "leg_sine", "leg_sawtooth"];
+const ALL: [&str; 22] = [
+    "stand_six_legs",
+    "stand_three_legs",
+    "unpowered_none",
+    "unpowered_dry_viscous",
+    "unpowered_lugre",
+    "leg_ramp",
+    "leg_sine",
+    "leg_sawtooth",
+    "validation_tripod_1cm",
+    "validation_tripod_1_5cm",
+    "validation_tripod_2cm",
+    "validation_tripod_2_5cm",
+    "simulation_time",
+    "path_back_and_forth",
+    "path_back_and_forth_no_navigation",
+    "path_straight_lines",
+    "path_straight_lines_no_navigation",
+    "path_spline",
+    "path_spline_no_navigation",
+    "soft_ground_enhanced",
+    "soft_ground_plain",
+    "gait_changes",
+];
 
 #[test]
 fn shipped_scenarios_are_valid() {
@@ -323,4 +349,236 @@ fn settling_failures_are_reported() {
     let m = e.to_string();
     assert!(matches!(e, ScenarioError::Simulation { .. } | ScenarioError::Tipped { .. }), "{m}");
     assert!(m.starts_with("bad.toml: settling") && m.contains("initial.lifted_legs") && !m.contains('\n'), "{m}");
+}
+
+// =============================================================================================
+// Gait mode
+// =============================================================================================
+
+#[test]
+fn walking_scenarios_parse() {
+    let s = Scenario::from_file(scenarios_dir().join("validation_tripod_1_5cm.toml")).unwrap();
+    assert_eq!(s.control, ControlMode::Gait);
+    assert_eq!((s.duration, s.model.friction), (60.0, FrictionModel::LuGre));
+    let g = s.gait.as_ref().unwrap();
+    assert_eq!(g.options.period, 12.0);
+    assert_eq!((g.options.pattern.name.as_str(), g.options.pattern.beta), ("tripod", 0.5));
+    assert_eq!(g.options.cycle, FootCycle::Enhanced { overlap: 0.05 });
+    assert_eq!((g.options.aep, g.options.lift, g.navigation), (AepMode::Periodic, 0.045, false));
+    match &g.heading {
+        HeadingSpec::Constant(h) => assert_eq!((h.velocity.x, h.velocity.y, h.yaw_rate), (0.015, 0.0, 0.0)),
+        h => panic!("{h:?}"),
+    }
+    // The default body height: q_v = 0.06 m (about 0.414 m); the legs start at their workspace
+    // centres, which the joints reach.
+    assert!((g.body_height - 0.414).abs() < 1e-3, "{}", g.body_height);
+    assert_eq!(s.initial.joints, g.joints);
+    assert!(s.initial.settle && s.initial.lifted_legs.is_empty());
+    for l in 0..6 {
+        let q = nalgebra::Vector3::new(g.joints[3 * l], g.joints[3 * l + 1], g.joints[3 * l + 2]);
+        let foot = g.legs[l].foot(&q);
+        assert!((foot - g.workspaces[l].centre_at(-g.body_height)).norm() < 1e-6, "leg {l}");
+    }
+    assert!(!s.plant.navigation);
+
+    let s = Scenario::from_file(scenarios_dir().join("path_spline.toml")).unwrap();
+    let g = s.gait.as_ref().unwrap();
+    assert!(matches!(g.heading, HeadingSpec::Spline { built_in: true, .. }));
+    assert_eq!((g.options.aep, g.navigation, s.plant.navigation), (AepMode::Omnidirectional, true, true));
+    assert_eq!(s.model.friction, FrictionModel::None);
+    let s = Scenario::from_file(scenarios_dir().join("soft_ground_plain.toml")).unwrap();
+    let g = s.gait.as_ref().unwrap();
+    assert_eq!((s.model.ground.k_gnd, g.options.lift, g.options.cycle), (1e4, 0.1, FootCycle::Plain));
+    let s = Scenario::from_file(scenarios_dir().join("gait_changes.toml")).unwrap();
+    let g = s.gait.as_ref().unwrap();
+    let changes: Vec<(f64, &str, f64)> = g.changes.iter().map(|c| (c.at, c.pattern.name.as_str(), c.pattern.beta)).collect();
+    assert_eq!(changes, vec![(20.0, "wave", 0.75), (50.0, "tripod", 0.5)]);
+    let s = Scenario::from_file(scenarios_dir().join("path_straight_lines_no_navigation.toml")).unwrap();
+    assert!(matches!(s.gait.as_ref().unwrap().heading, HeadingSpec::Square { side: 0.375, speed: 0.015 }));
+    assert!(!s.plant.navigation);
+
+    // Waypoints of a spline.
+    let text = with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 50.0, 100.0]\nx_m = [0.0, 0.5, 1.0]\ny_m = [0.0, 0.2, 0.0]");
+    assert!(matches!(parse(&text).unwrap().gait.unwrap().heading, HeadingSpec::Spline { built_in: false, .. }));
+}
+
+#[test]
+fn gait_errors_name_the_field() {
+    let v = "validation_tripod_1_5cm";
+    let s = field_error(&with(v, "pattern = \"tripod\"", "pattern = \"trot\""), "gait.pattern");
+    assert!(s.contains("trot") && s.contains("tripod") && s.contains("wave") && s.contains("equal_phase"), "{s}");
+    let line = shipped(v).lines().position(|l| l.starts_with("pattern")).unwrap() + 1;
+    assert!(s.starts_with(&format!("bad.toml:{line}:")), "{s}");
+
+    let s = field_error(&with(v, "pattern = \"tripod\"", "pattern = \"tripod\"\nduty_factor = 0.6"), "gait.duty_factor");
+    assert!(s.contains("0.6") && s.contains("0.5"), "{s}");
+    let s = field_error(&with(v, "pattern = \"tripod\"", "pattern = \"wave\"\nduty_factor = 0.9"), "gait.duty_factor");
+    assert!(s.contains("0.9") && s.contains("[0.5, 0.8)"), "{s}");
+    let s = field_error(&with(v, "cycle = \"enhanced\"", "cycle = \"plain\""), "gait.overlap");
+    assert!(s.contains("plain"), "{s}");
+    let s = field_error(&with(v, "cycle = \"enhanced\"", "cycle = \"fancy\""), "gait.cycle");
+    assert!(s.contains("fancy") && s.contains("enhanced") && s.contains("plain"), "{s}");
+    let s = field_error(&with(v, "aep = \"periodic\"", "aep = \"free\""), "gait.aep");
+    assert!(s.contains("periodic") && s.contains("omnidirectional"), "{s}");
+    let s = field_error(&with(v, "overlap = 0.05", "overlap = 0.2"), "gait.overlap");
+    assert!(s.contains("(0, 0.125)"), "{s}");
+    let s = field_error(&with(v, "period_s = 12.0", "period_s = 0.1"), "gait.period_s");
+    assert!(s.contains("0.1") && s.contains(">= 0.1333"), "{s}");
+    let s = field_error(&with(v, "period_s = 12.0", "period = 12.0"), "gait.period");
+    assert!(s.contains("unknown field") && s.contains("period_s"), "{s}");
+    let s = field_error(&with(v, "clearance_m = 0.045", "clearance_m = 0.3"), "gait.clearance_m");
+    assert!(s.contains("0.3") && s.contains("a clearance in (0, 0.12"), "{s}");
+    let s = field_error(&with(v, "clearance_m = 0.045", "clearance_m = 0.045\nbody_height_m = 0.6"), "gait.body_height_m");
+    assert!(s.contains("0.6") && s.contains("(0.2939, 0.5040)"), "{s}");
+
+    // The stroke must fit the workspace: 5 cm/s x 8.4 s = 0.42 m > 2 x 0.148 m.
+    let s = field_error(&with(v, "vx_m_s = 0.015", "vx_m_s = 0.05"), "gait.heading");
+    assert!(s.contains("does not fit the workspace") && s.contains("0.42") && s.contains("|v_C| <= 0.0352"), "{s}");
+    let line = shipped(v).lines().position(|l| l.starts_with("[gait.heading]")).unwrap() + 1;
+    assert!(s.starts_with(&format!("bad.toml:{line}:")), "{s}");
+
+    let s = field_error(&with(v, "omega_z_rad_s = 0.0", "omega_z_rad_s = 0.0\nside_m = 1.0"), "gait.heading.side_m");
+    assert!(s.contains("not a field of kind = \"constant\"") && s.contains("vx_m_s, vy_m_s, omega_z_rad_s"), "{s}");
+    let s = field_error(&with("path_straight_lines", "side_m = 0.375\n", ""), "gait.heading.side_m");
+    assert!(s.contains("<missing>") && s.contains("side_m, speed_m_s"), "{s}");
+    let s = field_error(&with("path_straight_lines", "speed_m_s = 0.015", "speed_m_s = -0.015"), "gait.heading.speed_m_s");
+    assert!(s.contains("> 0"), "{s}");
+    let s = field_error(&with(v, "kind = \"constant\"", "kind = \"joystick\""), "gait.heading.kind");
+    assert!(s.contains("joystick") && s.contains("back_and_forth") && s.contains("csv"), "{s}");
+    let s = field_error(&with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 10.0]"), "gait.heading.x_m");
+    assert!(s.contains("<missing>") && s.contains("built-in"), "{s}");
+    let s = field_error(&with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 10.0, 5.0]\nx_m = [0, 0.1, 0.2]\ny_m = [0, 0, 0]"), "gait.heading.t_s[2]");
+    assert!(s.contains("strictly increasing"), "{s}");
+    let s = field_error(&with(v, "kind = \"constant\"", "kind = \"csv\"\nfile = \"no_such.csv\"").replace("vx_m_s = 0.015\nvy_m_s = 0.0\nomega_z_rad_s = 0.0\n", ""), "gait.heading.file");
+    assert!(s.contains("no_such.csv") && s.contains("cannot read") && s.contains("t,vx,vy,omega_z"), "{s}");
+
+    let s = field_error(&with("gait_changes", "at_s = 50.0", "at_s = 90.0"), "gait.change[1].at_s");
+    assert!(s.contains("90") && s.contains("(20, 80)"), "{s}");
+    let s = field_error(&with("gait_changes", "pattern = \"wave\"", "pattern = \"wave\"\nspeed = 1"), "gait.change[0].speed");
+    assert!(s.contains("unknown field"), "{s}");
+
+    // Gait mode and the other tables.
+    let s = field_error(&with(v, "settle = true", "settle = true\nq_v_m = 0.06"), "initial.q_v_m");
+    assert!(s.contains("not used in gait mode") && s.contains("gait.body_height_m"), "{s}");
+    let s = field_error(&with(v, "settle = true", "lifted_legs = [1]"), "initial.lifted_legs");
+    assert!(s.contains("not used in gait mode"), "{s}");
+    let s = field_error(&with(v, "mode = \"gait\"", "mode = \"pi\""), "gait");
+    assert!(s.contains("control.mode = \"gait\""), "{s}");
+    let s = field_error(&with("stand_six_legs", "mode = \"pi\"", "mode = \"gait\""), "gait");
+    assert!(s.contains("<missing>") && s.contains("[gait]"), "{s}");
+    let s = field_error(&with(v, "mode = \"gait\"", "mode = \"gait\"\n[[control.motion]]\nleg = 0\njoint = \"q_v\"\nkind = \"sine\"\namplitude = 0.001\nfrequency_hz = 1.0"), "control.motion");
+    assert!(s.contains("mode = \"pi\""), "{s}");
+}
+
+/// A heading from a CSV file next to the scenario; a malformed file is reported with its line.
+#[test]
+fn csv_heading_relative_to_the_scenario() {
+    let dir = std::env::temp_dir().join(format!("hexadyn-gait-csv-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("paths")).unwrap();
+    std::fs::write(dir.join("paths/h.csv"), "t,vx,vy,omega_z\n0,0.01,0,0\n10,0.01,0.005,0.001\n").unwrap();
+    let text = shipped("validation_tripod_1_5cm").replace("kind = \"constant\"\nvx_m_s = 0.015\nvy_m_s = 0.0\nomega_z_rad_s = 0.0", "kind = \"csv\"\nfile = \"paths/h.csv\"");
+    std::fs::write(dir.join("s.toml"), &text).unwrap();
+    let s = Scenario::from_file(dir.join("s.toml")).unwrap();
+    match &s.gait.unwrap().heading {
+        HeadingSpec::Csv { file, series } => assert!(file.ends_with("h.csv") && series.t == vec![0.0, 10.0], "{file}"),
+        h => panic!("{h:?}"),
+    }
+    std::fs::write(dir.join("paths/h.csv"), "t,vx,vy,omega_z\n0,0.01,0,0\n10,fast,0,0\n").unwrap();
+    let e = Scenario::from_file(dir.join("s.toml")).unwrap_err().to_string();
+    assert!(e.contains("gait.heading.file") && e.contains("h.csv:3") && e.contains("\"fast\" is not a number"), "{e}");
+    // Too fast for the workspace somewhere in the file.
+    std::fs::write(dir.join("paths/h.csv"), "t,vx,vy,omega_z\n0,0.01,0,0\n10,0.01,0.05,0\n").unwrap();
+    let e = Scenario::from_file(dir.join("s.toml")).unwrap_err();
+    assert_eq!(e.field(), Some("gait.heading"), "{e}");
+    assert!(e.to_string().contains("csv heading") && e.to_string().contains("t = 10.00 s"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// 5 s of the validation walk: the gait columns are recorded with units, the foot phases go
+/// through support, takeoff, swing and landing, the body follows its reference; two runs are
+/// bit-identical.
+#[test]
+fn gait_runs_record_the_walk_deterministically() {
+    let s = short("validation_tripod_1_5cm", 5.0);
+    let a = run_scenario(&s, |_| {}).unwrap();
+    let b = run_scenario(&s, |_| {}).unwrap();
+    assert_eq!(a.series.columns.len(), b.series.columns.len());
+    for (x, y) in a.series.columns.iter().zip(&b.series.columns) {
+        assert_eq!(x.name, y.name);
+        let same = x.values.iter().zip(&y.values).all(|(u, v)| u.to_bits() == v.to_bits());
+        assert!(same && x.values.len() == y.values.len(), "column {} differs between two runs", x.name);
+    }
+    let series = &a.series;
+    assert_eq!(series.len(), 501);
+    let units = [
+        ("X_ref", "m"),
+        ("Y_ref", "m"),
+        ("Z_ref", "m"),
+        ("yaw_ref", "rad"),
+        ("pitch_ref", "rad"),
+        ("roll_ref", "rad"),
+        ("X_dot_ref", "m/s"),
+        ("omega_z_ref", "rad/s"),
+        ("duty_factor", "1"),
+        ("phase[0]", "1"),
+        ("phase[5]", "1"),
+        ("foot_ref_x[0]", "m"),
+        ("foot_ref_z[5]", "m"),
+        ("q_v_ref[3]", "m"),
+        ("z_q_v[2]", "m"),
+    ];
+    for (name, unit) in units {
+        assert_eq!(series.unit(name), Some(unit), "{name}");
+    }
+    for c in &series.columns {
+        assert!(c.values.iter().all(|v| v.is_finite()), "{} has non-finite values", c.name);
+    }
+    // Tripod {1, 2, 5} starts at phase 0.5: support to 0.3 s, takeoff to 1.2 s, swing to 4.8 s,
+    // then landing; tripod {0, 3, 4} stays in support.
+    let phase = |l: usize| series.values(&format!("phase[{l}]")).unwrap();
+    let at = |t: f64| (t / 0.01).round() as usize;
+    for l in [1, 2, 5] {
+        assert_eq!([phase(l)[at(0.1)], phase(l)[at(0.5)], phase(l)[at(3.0)], phase(l)[at(4.95)]], [0.0, 1.0, 2.0, 3.0], "leg {l}");
+    }
+    for l in [0, 3, 4] {
+        assert!(phase(l).iter().all(|&p| p == 0.0), "leg {l}");
+    }
+    let (x, x_ref) = (series.values("X").unwrap(), series.values("X_ref").unwrap());
+    assert!((x_ref[500] - 0.015 * (5.0 - 0.005)).abs() < 1e-9, "{}", x_ref[500]);
+    assert!((x[500] - x_ref[500]).abs() < 2e-3, "{} vs {}", x[500], x_ref[500]);
+    assert!(series.values("duty_factor").unwrap().iter().all(|&b| b == 0.5));
+    // Leg 1 lifts its foot reference by the clearance at mid-swing (t = 3 s).
+    let z = series.values("foot_ref_z[1]").unwrap();
+    assert!((z[at(3.0)] - z[0] - 0.045).abs() < 1e-3, "{}", z[at(3.0)] - z[0]);
+
+    let g = a.summary.gait.as_ref().expect("gait summary");
+    assert!(g.tracking_error_xy_max_m < 2e-3 && g.tracking_error_xy_final_m <= g.tracking_error_xy_max_m, "{g:?}");
+    assert!((g.reference_distance_m - 0.015 * 4.995).abs() < 1e-6, "{g:?}");
+    assert!((g.distance_walked_m - g.reference_distance_m).abs() < 3e-3, "{g:?}");
+    assert_eq!((g.clamped_ik_references, g.gait_switches, g.min_feet_on_ground), (0, 0, 3));
+    assert!(g.max_foot_reference_outside_workspace_m < 1e-6, "{g:?}");
+    let names: Vec<&str> = a.summary.entries().iter().map(|(n, _)| *n).collect();
+    for n in ["tracking_error_xy_max_m", "tracking_error_xy_final_m", "distance_walked_m", "clamped_ik_references", "gait_switches", "min_feet_on_ground"] {
+        assert!(names.contains(&n), "{n} missing from the summary");
+    }
+    assert_eq!(a.summary.control, "gait");
+}
+
+/// A gait change requested at 1 s is made once all six feet are down (the tripod's double
+/// support around t = 6 s): the duty factor column switches from 0.5 to 0.75.
+#[test]
+fn gait_changes_are_scheduled() {
+    let text = with("gait_changes", "duration_s = 80.0", "duration_s = 7.0")
+        .replace("at_s = 20.0", "at_s = 1.0")
+        .replace("[[gait.change]]\nat_s = 50.0\npattern = \"tripod\"\n", "");
+    let s = parse(&text).unwrap();
+    assert_eq!(s.gait.as_ref().unwrap().changes.len(), 1);
+    let r = run_scenario(&s, |_| {}).unwrap();
+    let beta = r.series.values("duty_factor").unwrap();
+    let t = r.series.values("t").unwrap();
+    let switch = beta.iter().position(|&b| b == 0.75).expect("switched to the wave gait");
+    assert!(beta[..switch].iter().all(|&b| b == 0.5) && beta[switch..].iter().all(|&b| b == 0.75));
+    assert!(t[switch] > 5.5 && t[switch] < 6.5, "switched at {}", t[switch]);
+    let g = r.summary.gait.unwrap();
+    assert_eq!((g.gait_switches, g.min_feet_on_ground), (1, 3));
 }

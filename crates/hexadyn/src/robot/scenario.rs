@@ -29,6 +29,7 @@
 //! h_max_s = 0.01                   # largest step, (0, control period]
 //!
 //! [initial]                        # optional table; defaults shown
+//!                                  # (gait mode: only settle and body_height_offset_m)
 //! q_r_deg = 0.0                    # q_r of every leg (deg, within the joint range)
 //! q_v_m = 0.06                     # q_v of the supporting legs (m)
 //! q_h_m = 0.03                     # q_h of every leg (m)
@@ -39,7 +40,8 @@
 //!
 //! [control]                        # optional table
 //! mode = "pi"                      # "pi": 18 digital PI loops (Table 4.1) holding the initial
-//!                                  # joints plus the motions below; "unpowered": 0 V
+//!                                  # joints plus the motions below; "unpowered": 0 V;
+//!                                  # "gait": walking, with a [gait] table (see `gait` below)
 //! [[control.motion]]               # any number; one per (leg, joint); needs mode = "pi"
 //! leg = 1                          # 0..5
 //! joint = "q_v"                    # "q_r" | "q_v" | "q_h"
@@ -47,6 +49,14 @@
 //! rate = 0.00857                   # "sine": amplitude, frequency_hz
 //!                                  # "sawtooth": min, max, speed
 //! ```
+//!
+//! Walking scenarios (`mode = "gait"`) add a `[gait]` table: period, pattern, duty factor,
+//! foot cycle and overlap, AEP mode, clearance, navigation, body height, `[gait.heading]` (the
+//! heading velocities: constant, CSV file, the paths of Section 7.5.3) and `[[gait.change]]`
+//! (gait changes while walking); its format is in the docs of the private submodule `gait`
+//! (`src/robot/scenario/gait.rs`), summarized in docs/architecture.md. Every support stroke
+//! |v_C| (β + 4Δφ) T must fit the workspace diameter. The legs start at their workspace centres
+//! at the body height.
 //!
 //! Motion values are SI joint units: rad, rad/s for q_r; m, m/s for q_v and q_h. The reference
 //! is the initial joint position (the base) plus the motion ([`JointMotion`]); it must stay
@@ -68,7 +78,12 @@
 //! | `X_dot` ... `roll_dot` | m/s; rad/s | body velocities |
 //! | `q_r[i]`, `q_v[i]`, `q_h[i]` | rad, m, m | joints of leg i |
 //! | `q_r_dot[i]` ... | rad/s, m/s | joint velocities |
-//! | `q_r_ref[i]` ... | rad, m | joint references (mode `pi` only) |
+//! | `q_r_ref[i]` ... | rad, m | joint references (modes `pi` and `gait`) |
+//! | `X_ref`, `Y_ref`, `Z_ref`; `yaw_ref`, `pitch_ref`, `roll_ref` | m; rad | desired body pose T*_{0,b} (gait) |
+//! | `X_dot_ref`, `Y_dot_ref`; `omega_z_ref` | m/s; rad/s | commanded heading velocities (gait) |
+//! | `duty_factor` | 1 | β of the current gait pattern (gait) |
+//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing (gait) |
+//! | `foot_ref_x[l]`, `foot_ref_y[l]`, `foot_ref_z[l]` | m | foot reference in the leg frame (gait) |
 //! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
 //! | `i_q_v[i]` ... | A | motor current |
 //! | `tau_m_q_v[i]` ... | Nm (q_r), N | motor torque at the joint, n k_t i |
@@ -80,6 +95,10 @@
 //! | `E_el_q_v[i]`, `E_joule_q_v[i]`, `E_fric_q_v[i]` ... | J | cumulative electrical energy ∫u i dt, Joule losses, friction work ∫τ_f q' dt |
 //! | `E_kin`, `E_pot` | J | kinetic and gravitational potential energy |
 //! | `E_contact`, `E_stored`, `E_balance` | J | cumulative work on the ground; energy in bristles, ground springs and inductances; energy balance error |
+//!
+//! In gait mode the [`Summary`] adds a [`GaitSummary`]: body XY tracking error (largest and
+//! final), yaw error, distance walked and its reference, clamped IK references, gait switches,
+//! fewest feet on the ground, largest excursion of a foot reference outside its workspace.
 //!
 //! Runs are deterministic: the same scenario gives bit-identical columns.
 
@@ -96,6 +115,9 @@ use super::model::{FrictionModel, ModelOptions, Robot, RobotModel};
 use super::recorder::{Recorder, TimeSeries};
 use super::simulation::{run_until, PlantOptions, SimulatedRobot};
 use super::{Joint, RobotDescription};
+
+mod gait;
+pub use gait::{phase_code, GaitChange, GaitScenario, GaitSummary, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 use crate::control::{Command, Controller, DigitalPi, JointMotion, JointPiController, JointReferences, Measurements, Unpowered, JOINTS};
 use crate::physics::FlatGround;
 use crate::sim::{static_equilibrium, SimError, StaticOptions};
@@ -178,6 +200,7 @@ struct RawScenario {
     initial: RawInitial,
     #[serde(default)]
     control: RawControl,
+    gait: Option<gait::RawGait>,
 }
 
 #[derive(Deserialize)]
@@ -230,16 +253,12 @@ struct RawIntegrator {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawInitial {
-    #[serde(default)]
-    q_r_deg: f64,
-    #[serde(default = "default_q_v")]
-    q_v_m: f64,
-    #[serde(default = "default_q_h")]
-    q_h_m: f64,
-    #[serde(default)]
-    lifted_legs: Vec<i64>,
-    #[serde(default = "default_q_v_lifted")]
-    q_v_lifted_m: f64,
+    // The joint fields are options so that gait mode can reject them when written.
+    q_r_deg: Option<f64>,
+    q_v_m: Option<f64>,
+    q_h_m: Option<f64>,
+    lifted_legs: Option<Vec<i64>>,
+    q_v_lifted_m: Option<f64>,
     #[serde(default = "default_true")]
     settle: bool,
     #[serde(default)]
@@ -261,7 +280,7 @@ fn default_true() -> bool {
 
 impl Default for RawInitial {
     fn default() -> Self {
-        RawInitial { q_r_deg: 0.0, q_v_m: default_q_v(), q_h_m: default_q_h(), lifted_legs: Vec::new(), q_v_lifted_m: default_q_v_lifted(), settle: true, body_height_offset_m: 0.0 }
+        RawInitial { q_r_deg: None, q_v_m: None, q_h_m: None, lifted_legs: None, q_v_lifted_m: None, settle: true, body_height_offset_m: 0.0 }
     }
 }
 
@@ -274,6 +293,9 @@ pub enum ControlMode {
     Pi,
     /// All voltages zero (Section 6.2): the motor circuits are closed through the H-bridges.
     Unpowered,
+    /// The gait controller of Chapter 7 (`[gait]` table): heading velocities, foot references,
+    /// inverse kinematics and the same 18 PI loops.
+    Gait,
 }
 
 impl ControlMode {
@@ -281,6 +303,7 @@ impl ControlMode {
         match self {
             ControlMode::Pi => "pi",
             ControlMode::Unpowered => "unpowered",
+            ControlMode::Gait => "gait",
         }
     }
 }
@@ -384,6 +407,8 @@ pub struct Scenario {
     pub initial: Initial,
     pub control: ControlMode,
     pub motions: Vec<Motion>,
+    /// The walking set-up, in gait mode.
+    pub gait: Option<GaitScenario>,
     /// The scenario file (or origin name).
     pub origin: String,
     /// The scenario text.
@@ -480,18 +505,46 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
         plant.integrator.h_initial = plant.integrator.h_initial.min(v);
     }
 
+    // Control mode and the walking set-up: in gait mode the initial joints come from the gait.
+    let mode = raw.control.mode;
+    let gait = match (mode, &raw.gait) {
+        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, dir, h.duration_s).map_err(e)?),
+        (ControlMode::Gait, None) => {
+            return Err(e(c.err("gait", "<missing>", "missing table", "a [gait] table with control.mode = \"gait\" (period_s, pattern, [gait.heading]; see the shipped walking scenarios)")));
+        }
+        (_, Some(_)) => {
+            return Err(e(c.err("gait", "[gait]", &format!("a [gait] table with control.mode = \"{}\"", mode.name()), "control.mode = \"gait\" with a [gait] table (or no [gait] table)")));
+        }
+        (_, None) => None,
+    };
+    if let Some(g) = &gait {
+        plant.navigation = g.navigation;
+    }
+
     // Initial configuration.
     let i = &raw.initial;
+    if gait.is_some() {
+        let written = [("q_r_deg", i.q_r_deg.map(|v| v.to_string())), ("q_v_m", i.q_v_m.map(|v| v.to_string())), ("q_h_m", i.q_h_m.map(|v| v.to_string())), ("lifted_legs", i.lifted_legs.as_ref().map(|v| format!("{v:?}"))), ("q_v_lifted_m", i.q_v_lifted_m.map(|v| v.to_string()))];
+        if let Some((name, Some(value))) = written.into_iter().find(|(_, v)| v.is_some()) {
+            return Err(e(c.err(
+                &format!("initial.{name}"),
+                value,
+                "not used in gait mode",
+                "only settle and body_height_offset_m in [initial] with control.mode = \"gait\": the feet start at their workspace centres at gait.body_height_m",
+            )));
+        }
+    }
+    let (q_r_deg, q_v_m, q_h_m, q_v_lifted_m) = (i.q_r_deg.unwrap_or(0.0), i.q_v_m.unwrap_or_else(default_q_v), i.q_h_m.unwrap_or_else(default_q_h), i.q_v_lifted_m.unwrap_or_else(default_q_v_lifted));
     let range = |j: Joint| robot.joint_range(j);
     let stroke = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str, what: &str| {
         c.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}] {unit} ({what} of the robot description, joint_ranges)"))
     };
     let r = &robot.joint_ranges.q_r_deg;
-    stroke("initial.q_r_deg", i.q_r_deg, (r.min, r.max), "deg", "the q_r range").map_err(e)?;
-    stroke("initial.q_v_m", i.q_v_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
-    stroke("initial.q_h_m", i.q_h_m, range(Joint::Horizontal), "m", "the q_h stroke").map_err(e)?;
+    stroke("initial.q_r_deg", q_r_deg, (r.min, r.max), "deg", "the q_r range").map_err(e)?;
+    stroke("initial.q_v_m", q_v_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
+    stroke("initial.q_h_m", q_h_m, range(Joint::Horizontal), "m", "the q_h stroke").map_err(e)?;
     let mut lifted = Vec::new();
-    for (n, &leg) in i.lifted_legs.iter().enumerate() {
+    for (n, &leg) in i.lifted_legs.iter().flatten().enumerate() {
         let field = format!("initial.lifted_legs[{n}]");
         if !(0..6).contains(&leg) {
             return Err(e(c.err(&field, leg, "no such leg", "a leg number 0..5")));
@@ -504,13 +557,13 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
     }
     lifted.sort_unstable();
     if !lifted.is_empty() {
-        stroke("initial.q_v_lifted_m", i.q_v_lifted_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
-        if i.q_v_lifted_m >= i.q_v_m {
+        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
+        if q_v_lifted_m >= q_v_m {
             return Err(e(c.err(
                 "initial.q_v_lifted_m",
-                i.q_v_lifted_m,
+                q_v_lifted_m,
                 "does not lift the foot",
-                format!("a value < initial.q_v_m = {} (a smaller q_v lifts the foot, z_foot ~ -6 q_v)", i.q_v_m),
+                format!("a value < initial.q_v_m = {q_v_m} (a smaller q_v lifts the foot, z_foot ~ -6 q_v)"),
             )));
         }
     }
@@ -523,23 +576,30 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
         )));
     }
     c.check(i.body_height_offset_m >= 0.0, "initial.body_height_offset_m", i.body_height_offset_m, "a finite number >= 0 (m, added to the body height after settling)").map_err(e)?;
-    let joints: [f64; JOINTS] = std::array::from_fn(|k| match k % 3 {
-        0 => i.q_r_deg.to_radians(),
-        1 => {
-            if lifted.contains(&(k / 3)) {
-                i.q_v_lifted_m
-            } else {
-                i.q_v_m
+    let joints: [f64; JOINTS] = match &gait {
+        Some(g) => g.joints,
+        None => std::array::from_fn(|k| match k % 3 {
+            0 => q_r_deg.to_radians(),
+            1 => {
+                if lifted.contains(&(k / 3)) {
+                    q_v_lifted_m
+                } else {
+                    q_v_m
+                }
             }
-        }
-        _ => i.q_h_m,
-    });
+            _ => q_h_m,
+        }),
+    };
     let initial = Initial { joints, lifted_legs: lifted, settle: i.settle, body_height_offset: i.body_height_offset_m };
 
-    // Control.
-    let mode = raw.control.mode;
-    if mode == ControlMode::Unpowered && !raw.control.motion.is_empty() {
-        return Err(e(c.err("control.motion", format!("{} motion(s)", raw.control.motion.len()), "motions need powered joints", "no [[control.motion]] with mode = \"unpowered\" (or mode = \"pi\")")));
+    // Joint motions.
+    if mode != ControlMode::Pi && !raw.control.motion.is_empty() {
+        return Err(e(c.err(
+            "control.motion",
+            format!("{} motion(s)", raw.control.motion.len()),
+            &format!("motions need mode = \"pi\" (not \"{}\")", mode.name()),
+            format!("no [[control.motion]] with mode = \"{}\" (or mode = \"pi\")", mode.name()),
+        )));
     }
     let mut motions = Vec::new();
     let mut seen = BTreeSet::new();
@@ -563,6 +623,7 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
         initial,
         control: mode,
         motions,
+        gait,
         origin: origin.to_string(),
         text: text.to_string(),
     })
@@ -702,6 +763,8 @@ pub struct Summary {
     pub max_tracking_error: Option<[f64; 3]>,
     /// Largest foot penetration into the ground.
     pub max_penetration_m: f64,
+    /// Walking figures, in gait mode.
+    pub gait: Option<GaitSummary>,
 }
 
 impl Summary {
@@ -743,6 +806,21 @@ impl Summary {
             v.push(("max_tracking_error_q_h_m", Number(hh)));
         }
         v.push(("max_penetration_m", Number(self.max_penetration_m)));
+        if let Some(g) = &self.gait {
+            v.push(("gait_pattern", Text(g.pattern.clone())));
+            v.push(("gait_cycle", Text(g.cycle.to_string())));
+            v.push(("gait_heading", Text(g.heading.to_string())));
+            v.push(("navigation", Text(g.navigation.to_string())));
+            v.push(("tracking_error_xy_max_m", Number(g.tracking_error_xy_max_m)));
+            v.push(("tracking_error_xy_final_m", Number(g.tracking_error_xy_final_m)));
+            v.push(("tracking_error_yaw_max_rad", Number(g.tracking_error_yaw_max_rad)));
+            v.push(("distance_walked_m", Number(g.distance_walked_m)));
+            v.push(("reference_distance_m", Number(g.reference_distance_m)));
+            v.push(("clamped_ik_references", Count(g.clamped_ik_references)));
+            v.push(("gait_switches", Count(g.gait_switches)));
+            v.push(("min_feet_on_ground", Count(g.min_feet_on_ground)));
+            v.push(("max_foot_reference_outside_workspace_m", Number(g.max_foot_reference_outside_workspace_m)));
+        }
         v
     }
 }
@@ -788,7 +866,14 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     q[2] += s.initial.body_height_offset;
 
     let mut plant = SimulatedRobot::new(model.clone(), &q, &qd, &s.plant).map_err(sim_err("the start"))?;
+    let mut gait_state = None;
     let mut controller: Box<dyn Controller> = match s.control {
+        ControlMode::Gait => {
+            let g = s.gait.as_ref().expect("gait mode has a validated [gait]");
+            let (controller, state) = gait::ScheduledGait::new(g, &s.robot);
+            gait_state = Some(state);
+            Box::new(controller)
+        }
         ControlMode::Pi => {
             let pis = std::array::from_fn(|k| {
                 let g = s.robot.pi_gains(Joint::ALL[k % 3]);
@@ -801,14 +886,21 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     };
 
     let lugre = s.model.friction == FrictionModel::LuGre;
-    let pi = s.control == ControlMode::Pi;
+    // The joint references are recorded and tracked by the PI loops in these modes.
+    let pi = matches!(s.control, ControlMode::Pi | ControlMode::Gait);
     let supply = s.model.supply_voltage;
     let mut rec = Recorder::default();
     let mut stats = RunStats::default();
+    let mut gait_stats = gait::GaitStats::default();
     let mut last_t = 0.0;
     let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
-        record_row(&mut rec, p, meas, cmd, lugre, pi);
+        let state = gait_state.as_ref().map(|g| g.borrow());
+        record_row(&mut rec, p, meas, cmd, lugre, pi, state.as_deref());
         stats.observe(p, cmd, supply, pi);
+        if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
+            let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
+            gait_stats.observe(p.state().q.as_slice(), state, feet_down, &g.workspaces);
+        }
         last_t = meas.t;
         progress(meas.t)
     })
@@ -818,7 +910,10 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     }
 
     let series = rec.finish();
-    let summary = summarize(s, &plant, &series, &stats, &q, started.elapsed().as_secs_f64());
+    let mut summary = summarize(s, &plant, &series, &stats, &q, started.elapsed().as_secs_f64());
+    if let (Some(g), Some(state)) = (&s.gait, &gait_state) {
+        summary.gait = Some(GaitSummary::new(g, &gait_stats, &state.borrow().diagnostics));
+    }
     Ok(ScenarioResults { series, summary })
 }
 
@@ -900,8 +995,32 @@ fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &
         max_abs_voltage_v: stats.max_abs_voltage,
         saturated_fraction: if stats.commands > 0 { stats.saturated as f64 / stats.commands as f64 } else { 0.0 },
         limit_switch_cuts: stats.cuts,
-        max_tracking_error: (s.control == ControlMode::Pi).then_some(stats.tracking),
+        max_tracking_error: matches!(s.control, ControlMode::Pi | ControlMode::Gait).then_some(stats.tracking),
         max_penetration_m: max_penetration,
+        gait: None,
+    }
+}
+
+/// The gait controller's columns: desired body pose and velocities, duty factor, foot phases
+/// and foot references.
+fn record_gait(rec: &mut Recorder, g: &gait::GaitState) {
+    let s = |x: &str| x.to_string();
+    let pose = [g.pose.position.x, g.pose.position.y, g.pose.position.z, g.pose.angles.x, g.pose.angles.y, g.pose.angles.z];
+    const POSE: [(&str, &str); 6] = [("X_ref", "m"), ("Y_ref", "m"), ("Z_ref", "m"), ("yaw_ref", "rad"), ("pitch_ref", "rad"), ("roll_ref", "rad")];
+    for ((n, u), v) in POSE.iter().zip(pose) {
+        rec.put(v, || (s(n), u, format!("desired body pose {} (T*_0,b, Eq. 7.12-7.23)", &n[..n.len() - 4])));
+    }
+    rec.put(g.velocity.x, || (s("X_dot_ref"), "m/s", s("commanded heading velocity V_x (global)")));
+    rec.put(g.velocity.y, || (s("Y_dot_ref"), "m/s", s("commanded heading velocity V_y (global)")));
+    rec.put(g.omega.z, || (s("omega_z_ref"), "rad/s", s("commanded yaw rate Omega_z")));
+    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern")));
+    for (l, phase) in g.phases.iter().enumerate() {
+        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing")));
+    }
+    for (l, f) in g.feet.iter().enumerate() {
+        rec.put(f.x, || (format!("foot_ref_x[{l}]"), "m", s("foot reference x, leg frame")));
+        rec.put(f.y, || (format!("foot_ref_y[{l}]"), "m", s("foot reference y, leg frame")));
+        rec.put(f.z, || (format!("foot_ref_z[{l}]"), "m", s("foot reference z, leg frame")));
     }
 }
 
@@ -919,7 +1038,7 @@ fn joint_name(prefix: &str, k: usize, suffix: &str) -> String {
     format!("{prefix}{}{suffix}[{}]", Joint::ALL[k % 3].symbol(), k / 3)
 }
 
-fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: &Command, lugre: bool, pi: bool) {
+fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: &Command, lugre: bool, pi: bool, gait: Option<&gait::GaitState>) {
     let st = p.state();
     let (q, qd) = (st.q.as_slice(), st.qd.as_slice());
     let out = &p.robot.outputs;
@@ -945,6 +1064,9 @@ fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: 
         for k in 0..JOINTS {
             rec.put(cmd.references[k], || (joint_name("", k, "_ref"), joint_unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
         }
+    }
+    if let Some(g) = gait {
+        record_gait(rec, g);
     }
     for k in 0..JOINTS {
         rec.put(out.voltage[k], || (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));

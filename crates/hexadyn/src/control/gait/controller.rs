@@ -97,6 +97,11 @@ impl GaitController {
     pub fn desired_pose(&self) -> Option<Pose> {
         self.body.as_ref().map(|b| b.pose)
     }
+    /// The desired body velocity v*_{b/0} and angular velocity ω*_{b/0} (global frame) at the
+    /// last update.
+    pub fn desired_velocity(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        self.body.as_ref().map(|b| (b.velocity(), b.omega()))
+    }
     /// Foot references in the leg frames at the last update.
     pub fn foot_references(&self) -> [Vector3<f64>; 6] {
         self.legs.map(|l| l.foot)
