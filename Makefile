@@ -57,6 +57,8 @@ test-python: setup
 
 bench:
 	$(CARGO) run --release -p hexadyn-benches --bin engine
+	$(CARGO) run --release -p hexadyn-benches --bin robot
+	$(CARGO) run --release -p hexadyn-benches --bin gait
 
 # Resolve the locks in throw-away venvs (needs PyPI); review the diff before committing.
 lock:
