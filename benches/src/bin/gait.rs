@@ -10,11 +10,11 @@ use std::time::Instant;
 use hexadyn::control::gait::controller::{AepMode, GaitController, GaitOptions};
 use hexadyn::control::gait::heading::{Constant, Heading};
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
-use hexadyn::control::{Controller, DigitalPi, LegKinematics, Measurements, JOINTS};
+use hexadyn::control::{joint_pis, Controller, LegKinematics, Measurements, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::{Joint, RobotDescription};
+use hexadyn::robot::RobotDescription;
 use nalgebra::Vector3;
 
 const THESIS_WALL_S: f64 = 260.0;
@@ -29,10 +29,7 @@ fn controller(d: &RobotDescription, period: f64, vx: f64) -> (GaitController, [f
         let ik = legs[l].inverse(&workspaces[l].centre_at(-height), &Vector3::new(0.0, 0.06, 0.03)).unwrap();
         joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
     }
-    let pis = std::array::from_fn(|k| {
-        let g = d.pi_gains(Joint::ALL[k % 3]);
-        DigitalPi::new(g.k, g.t_i, d.controller.period_s)
-    });
+    let pis = joint_pis(&d, d.controller.period_s);
     let options = GaitOptions { period, pattern: GaitPattern::tripod(), cycle: FootCycle::Enhanced { overlap: 0.05 }, aep: AepMode::Omnidirectional, lift, dt: d.controller.period_s };
     (GaitController::new(options, legs, workspaces, pis, Box::new(Constant(Heading::new(vx, 0.0, 0.0)))), joints)
 }

@@ -6,11 +6,11 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use hexadyn::control::{DigitalPi, JointMotion, JointPiController, JointReferences, JOINTS};
+use hexadyn::control::{joint_pis, JointMotion, JointPiController, JointReferences, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::{Joint, RobotDescription};
+use hexadyn::robot::RobotDescription;
 
 const THESIS_REAL_TIME_FACTOR: f64 = 75.0 / 260.0;
 
@@ -30,10 +30,7 @@ fn main() {
             });
             let q = model.touching_ground(&base);
             let qd = vec![0.0; q.len()];
-            let pis = std::array::from_fn(|k| {
-                let g = d.pi_gains(Joint::ALL[k % 3]);
-                DigitalPi::new(g.k, g.t_i, d.controller.period_s)
-            });
+            let pis = joint_pis(&d, d.controller.period_s);
             let motions = if lifted {
                 vec![(3, JointMotion::Sawtooth { min: -0.35, max: 0.35, speed: 0.15 }), (4, JointMotion::Sawtooth { min: 0.04, max: 0.05, speed: 0.004 }), (5, JointMotion::Sawtooth { min: 0.01, max: 0.05, speed: 0.004 })]
             } else {

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use hexadyn::control::{DigitalPi, JointMotion, JointPiController, JointReferences, ReferenceFeed, JOINTS};
+use hexadyn::control::{joint_pis, DigitalPi, JointMotion, JointPiController, JointReferences, ReferenceFeed, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
@@ -17,10 +17,7 @@ fn model(friction: FrictionModel, tweak: impl FnOnce(&mut ModelOptions)) -> Arc<
 }
 
 fn pis(d: &RobotDescription) -> [DigitalPi; JOINTS] {
-    std::array::from_fn(|k| {
-        let g = d.pi_gains(Joint::ALL[k % 3]);
-        DigitalPi::new(g.k, g.t_i, d.controller.period_s)
-    })
+    joint_pis(d, d.controller.period_s)
 }
 
 /// Legs 0, 3, 4 support the body; legs 1, 2, 5 are lifted.

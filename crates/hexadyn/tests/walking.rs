@@ -6,11 +6,11 @@ use hexadyn::control::gait::controller::{AepMode, GaitController, GaitOptions};
 use hexadyn::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Spline};
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
-use hexadyn::control::{Controller, DigitalPi, LegKinematics, Measurements, Plant, JOINTS};
+use hexadyn::control::{joint_pis, Controller, LegKinematics, Measurements, Plant, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::{Joint, RobotDescription};
+use hexadyn::robot::RobotDescription;
 use nalgebra::Vector3;
 
 struct Walk {
@@ -46,10 +46,7 @@ fn walk_lifting(lift: f64, friction: FrictionModel, heading: Box<dyn HeadingSour
     let mut plant_options = PlantOptions::from_description(&d);
     plant_options.navigation = navigation;
     let plant = SimulatedRobot::new(model, &q, &qd, &plant_options).unwrap();
-    let pis = std::array::from_fn(|k| {
-        let g = d.pi_gains(Joint::ALL[k % 3]);
-        DigitalPi::new(g.k, g.t_i, d.controller.period_s)
-    });
+    let pis = joint_pis(&d, d.controller.period_s);
     let options = GaitOptions { period: 12.0, pattern: GaitPattern::tripod(), cycle, aep, lift, dt: d.controller.period_s };
     Walk { plant, controller: GaitController::new(options, legs, workspaces, pis, heading) }
 }

@@ -10,6 +10,6 @@ mod leg_kinematics;
 mod pi;
 
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant, JOINTS};
-pub use joint_control::{JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
+pub use joint_control::{joint_pis, JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
 pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegKinematics, LegKinematicsError, Limit, Workspace};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};

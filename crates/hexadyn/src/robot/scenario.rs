@@ -118,7 +118,7 @@ use super::{Joint, RobotDescription};
 
 mod gait;
 pub use gait::{phase_code, GaitChange, GaitScenario, GaitSummary, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
-use crate::control::{Command, Controller, DigitalPi, JointMotion, JointPiController, JointReferences, Measurements, Unpowered, JOINTS};
+use crate::control::{joint_pis, Command, Controller, JointMotion, JointPiController, JointReferences, Measurements, Unpowered, JOINTS};
 use crate::physics::FlatGround;
 use crate::sim::{static_equilibrium, SimError, StaticOptions};
 
@@ -875,10 +875,7 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
             Box::new(controller)
         }
         ControlMode::Pi => {
-            let pis = std::array::from_fn(|k| {
-                let g = s.robot.pi_gains(Joint::ALL[k % 3]);
-                DigitalPi::new(g.k, g.t_i, s.plant.period)
-            });
+            let pis = joint_pis(&s.robot, s.plant.period);
             let motions = s.motions.iter().map(|m| (m.joint_index(), m.motion)).collect();
             Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } })
         }

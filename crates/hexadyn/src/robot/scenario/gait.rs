@@ -48,9 +48,9 @@ use crate::control::gait::body_motion::Pose;
 use crate::control::gait::controller::{AepMode, GaitController, GaitDiagnostics, GaitOptions};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
-use crate::control::{Command, Controller, DigitalPi, LegKinematics, Measurements, Workspace, JOINTS};
+use crate::control::{joint_pis, Command, Controller, LegKinematics, Measurements, Workspace, JOINTS};
 use crate::robot::description::{Ctx, DescriptionError};
-use crate::robot::{Joint, RobotDescription};
+use crate::robot::RobotDescription;
 
 type Result<T> = std::result::Result<T, DescriptionError>;
 
@@ -514,10 +514,7 @@ pub(super) struct ScheduledGait {
 impl ScheduledGait {
     pub(super) fn new(g: &GaitScenario, robot: &RobotDescription) -> (Self, Rc<RefCell<GaitState>>) {
         let dt = g.options.dt;
-        let pis = std::array::from_fn(|k| {
-            let gains = robot.pi_gains(Joint::ALL[k % 3]);
-            DigitalPi::new(gains.k, gains.t_i, dt)
-        });
+        let pis = joint_pis(robot, dt);
         let controller = GaitController::new(g.options.clone(), g.legs.clone(), g.workspaces, pis, g.heading.source());
         let state = Rc::new(RefCell::new(GaitState::default()));
         (ScheduledGait { controller, changes: g.changes.clone(), next: 0, state: state.clone() }, state)
