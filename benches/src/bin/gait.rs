@@ -7,7 +7,7 @@ use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
 
-use hexadyn::control::gait::controller::{AepMode, GaitController, GaitOptions};
+use hexadyn::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitOptions};
 use hexadyn::control::gait::heading::{Constant, Heading};
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
 use hexadyn::control::{joint_pis, Controller, LegKinematics, Measurements, JOINTS};
@@ -24,11 +24,7 @@ fn controller(d: &RobotDescription, period: f64, vx: f64) -> (GaitController, [f
     let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
     let lift = 0.045;
     let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
-    let mut joints = [0.0; JOINTS];
-    for l in 0..6 {
-        let ik = legs[l].inverse(&workspaces[l].centre_at(-height), &Vector3::new(0.0, 0.06, 0.03)).unwrap();
-        joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
-    }
+    let joints = joints_at_workspace_centres(&legs, &workspaces, height).unwrap();
     let pis = joint_pis(&d, d.controller.period_s);
     let options = GaitOptions { period, pattern: GaitPattern::tripod(), cycle: FootCycle::Enhanced { overlap: 0.05 }, aep: AepMode::Omnidirectional, lift, dt: d.controller.period_s };
     (GaitController::new(options, legs, workspaces, pis, Box::new(Constant(Heading::new(vx, 0.0, 0.0)))), joints)

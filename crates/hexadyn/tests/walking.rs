@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use hexadyn::control::gait::controller::{AepMode, GaitController, GaitOptions};
+use hexadyn::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitOptions};
 use hexadyn::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Spline};
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
@@ -31,13 +31,7 @@ fn walk_lifting(lift: f64, friction: FrictionModel, heading: Box<dyn HeadingSour
     let legs = LegKinematics::hexapod_from_description(&d).unwrap();
     let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
     let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
-    let mut joints = [0.0; JOINTS];
-    for l in 0..6 {
-        let c = workspaces[l].centre_at(-height);
-        let ik = legs[l].inverse(&c, &Vector3::new(0.0, 0.06, 0.03)).unwrap();
-        assert!(ik.is_reached());
-        joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
-    }
+    let joints = joints_at_workspace_centres(&legs, &workspaces, height).unwrap();
     let mut model_options = ModelOptions::from_description(&d, friction);
     tweak(&mut model_options);
     let model = Arc::new(RobotModel::new(&d, model_options, Arc::new(FlatGround { height: 0.0 })));

@@ -212,6 +212,21 @@ impl GaitController {
     }
 }
 
+/// The walking start posture: the joints that put every foot at the centre of its workspace on
+/// the ground `height` below the body (leg frame z = −height), found by Eq. 7.7 from the
+/// neutral posture. The error is the first leg that cannot reach its centre.
+pub fn joints_at_workspace_centres(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64) -> Result<[f64; JOINTS], usize> {
+    let neutral = Vector3::new(0.0, 0.06, 0.03);
+    let mut joints = [0.0; JOINTS];
+    for l in 0..6 {
+        match legs[l].inverse(&workspaces[l].centre_at(-height), &neutral) {
+            Ok(ik) if ik.is_reached() => joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice()),
+            _ => return Err(l),
+        }
+    }
+    Ok(joints)
+}
+
 fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
     Vector3::new(m.positions[3 * leg], m.positions[3 * leg + 1], m.positions[3 * leg + 2])
 }

@@ -45,7 +45,7 @@ use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::control::gait::body_motion::Pose;
-use crate::control::gait::controller::{AepMode, GaitController, GaitDiagnostics, GaitOptions};
+use crate::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitDiagnostics, GaitOptions};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
 use crate::control::{joint_pis, Command, Controller, LegKinematics, Measurements, Workspace, JOINTS};
@@ -63,8 +63,6 @@ pub const DEFAULT_DUTY_FACTOR: f64 = 0.75;
 /// The posture whose body height is the default (q_v = 0.06 m as the standing scenarios; q_h
 /// does not change the foot height to first order).
 const DEFAULT_POSTURE: [f64; 3] = [0.0, 0.06, 0.035];
-/// Start of the inverse kinematics of the initial posture.
-const IK_START: [f64; 3] = [0.0, 0.06, 0.03];
 
 // =============================================================================================
 // Raw mirror of the [gait] table
@@ -334,15 +332,8 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
         }
     }
     let workspaces: [Workspace; 6] = workspaces.try_into().expect("six legs");
-    let mut joints = [0.0; JOINTS];
-    for l in 0..6 {
-        let centre = workspaces[l].centre_at(-height);
-        let ik = legs[l].inverse(&centre, &Vector3::from(IK_START)).map_err(|e| c.err("gait.body_height_m", height, &format!("inverse kinematics failed: {e}"), reach.clone()))?;
-        if !ik.is_reached() {
-            return Err(c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its workspace centre"), reach));
-        }
-        joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
-    }
+    let joints = joints_at_workspace_centres(&legs, &workspaces, height)
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its workspace centre"), reach.clone()))?;
 
     let heading = validate_heading(&g.heading, c, dir)?;
 
