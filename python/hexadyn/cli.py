@@ -58,6 +58,37 @@ def info() -> None:
         click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT} ({robot})")
 
 
+def _parse_legs(ctx: click.Context, param: click.Parameter, value: str) -> tuple[int, ...]:
+    from hexadyn import plots
+
+    try:
+        return plots.parse_legs(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def _parse_formats(ctx: click.Context, param: click.Parameter, value: str) -> tuple[str, ...]:
+    from hexadyn import plots
+
+    formats = tuple(dict.fromkeys(f.strip().lower() for f in value.split(",") if f.strip()))
+    if not formats or any(f not in plots.FORMATS for f in formats):
+        raise click.BadParameter(f"{value!r}; allowed: comma-separated formats among {', '.join(plots.FORMATS)}")
+    return formats
+
+
+#: Options shared by `simulate` and `plot`.
+plot_options = [
+    click.option("--legs", default="0,2", show_default=True, callback=_parse_legs, help="Legs of the per-actuator figures: comma-separated 0..5, or all."),
+    click.option("--formats", default="png", show_default=True, callback=_parse_formats, help="Figure file formats: png (300 dpi), pdf, svg, comma-separated."),
+]
+
+
+def with_plot_options(f):
+    for option in reversed(plot_options):
+        f = option(f)
+    return f
+
+
 @cli.command()
 @click.argument("scenario", required=False, default=None)
 @click.option(
@@ -69,10 +100,14 @@ def info() -> None:
 )
 @click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool) -> None:
+@click.option("--no-plots", is_flag=True, help="Do not write the figures into <out>/plots/.")
+@with_plot_options
+def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
 
-    Without SCENARIO the default scenario is run (see `hexadyn scenarios`).
+    Without SCENARIO the default scenario is run (see `hexadyn scenarios`). The results folder
+    gets the time series, the summary, the power and energy tables (power.csv, energy.csv) and,
+    unless --no-plots, the figures in plots/ (see `hexadyn plot`).
     """
     from hexadyn import _core
 
@@ -83,7 +118,8 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
         out = _free_folder(RESULTS_ROOT / info["name"])
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
-    results = hexadyn.simulate(path, out=out, progress=not no_progress, overwrite=overwrite)
+    results = hexadyn.simulate(path, progress=not no_progress)
+    results.save(out, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
     s = results.summary
     click.echo(f"Results: {out}")
     click.echo(f"  scenario    {info['name']} ({path})")
@@ -104,6 +140,38 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
             f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
+    _echo_power(results)
+    if not no_plots:
+        click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
+
+
+def _echo_power(results: hexadyn.Results) -> None:
+    """The averaged power table (Tables 6.3-6.6 layout) and the key figures of the run."""
+    from hexadyn import energy
+
+    table = energy.averaged_power(results)
+    s = results.summary
+    click.echo(f"  power       averaged power {s['average_power_w']:.4g} W; friction work {100 * s['friction_share']:.1f} %, Joule {100 * s['joule_share']:.1f} % of the electrical energy")
+    if "specific_resistance" in s:
+        click.echo(f"              specific resistance {s['specific_resistance']:.4g} (Eq. 6.6, m = {s['robot_mass_kg']:g} kg)")
+    phases = [p for p in table.index.unique("phase") if p != energy.ALL]
+    if phases:
+        total = table.xs(energy.TOTAL, level="leg")[energy.TOTAL]
+        click.echo("              by foot phase: " + ", ".join(f"{p} {total[p]:.3g} W" for p in phases))
+    click.echo("  averaged power per actuator (W):")
+    block = table.loc[energy.ALL].rename(index=lambda leg: f"leg {leg}" if leg != energy.TOTAL else leg).rename_axis(index=None, columns=None)
+    for line in block.to_string(float_format=lambda v: f"{v:7.3f}").splitlines():
+        click.echo(f"    {line}")
+
+
+@cli.command()
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path))
+@with_plot_options
+def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
+    """(Re)generate the figures of the results FOLDER into FOLDER/plots/ (replaced atomically)."""
+    results = hexadyn.Results.load(folder)
+    figures = results.plot(folder / "plots", legs=legs, formats=formats)
+    click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
 
 
 @cli.command()

@@ -1,13 +1,18 @@
 """Simulation results: time series with units, a summary and metadata, saved as a folder.
 
-A results folder holds three files, written atomically (all or nothing):
+A results folder holds these files, written atomically (all or nothing):
 
 - ``timeseries.parquet``: one row per control instant, indexed by ``t`` (s); the units are also
   in the Parquet schema metadata (key ``hexadyn``);
 - ``metadata.json``: the scenario and robot description texts, the hexadyn version, the units
   and a one-line description of every column;
 - ``summary.json``: totals and diagnostics of the run (energies, integration statistics, body
-  height change, saturation, tracking errors).
+  height change, saturation, tracking errors) and the key figures of the power analysis
+  (:func:`hexadyn.energy.energy_figures`: average power, friction share, specific resistance);
+- ``power.csv``: averaged power per leg and joint type, split by foot phase
+  (:func:`hexadyn.energy.averaged_power`, Tables 6.3-6.6);
+- ``energy.csv``: energy breakdown per actuator (:func:`hexadyn.energy.energy_breakdown`);
+- ``plots/`` (optional): the figures of :mod:`hexadyn.plots`.
 """
 
 from __future__ import annotations
@@ -20,19 +25,23 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
-if TYPE_CHECKING:  # pandas is imported when results are built (keeps `import hexadyn` light)
+if TYPE_CHECKING:  # pandas and matplotlib are imported when needed (keeps `import hexadyn` light)
     import pandas as pd
+    from matplotlib.figure import Figure
 
 TIMESERIES_FILE = "timeseries.parquet"
 METADATA_FILE = "metadata.json"
 SUMMARY_FILE = "summary.json"
+POWER_FILE = "power.csv"
+ENERGY_FILE = "energy.csv"
+PLOTS_DIR = "plots"
 #: Identifies a hexadyn results folder in metadata.json.
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
 
-__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE"]
+__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE", "POWER_FILE", "ENERGY_FILE", "PLOTS_DIR"]
 
 
 class Results:
@@ -71,7 +80,7 @@ class Results:
         """Builds the results from the dict returned by ``hexadyn._core.run_scenario``."""
         import pandas as pd
 
-        from hexadyn import __version__
+        from hexadyn import __version__, energy
 
         columns = raw["columns"]
         frame = pd.DataFrame({name: values for name, values in columns.items()})
@@ -92,7 +101,9 @@ class Results:
             "units": units,
             "descriptions": descriptions,
         }
-        return cls(frame, units, summary, metadata)
+        results = cls(frame, units, summary, metadata)
+        results.summary.update(energy.energy_figures(results))
+        return results
 
     # -----------------------------------------------------------------------------------------
     # Access
@@ -117,52 +128,71 @@ class Results:
     # Saving and loading
     # -----------------------------------------------------------------------------------------
 
-    def save(self, folder: str | os.PathLike, *, overwrite: bool = False) -> Path:
+    def save(
+        self,
+        folder: str | os.PathLike,
+        *,
+        overwrite: bool = False,
+        plots: bool = False,
+        legs: Sequence[int] | None = None,
+        formats: Sequence[str] | None = None,
+    ) -> Path:
         """Writes the results folder atomically and returns its path.
 
-        The three files are written into a temporary folder next to ``folder`` which is then
-        renamed to ``folder``: either the complete folder appears or nothing does (a failure
-        removes the temporary folder and any parent folders this call created). An existing
-        ``folder`` is an error (FileExistsError) unless ``overwrite`` is true, in which case it is
-        replaced only once the new folder is complete.
+        The files (and with ``plots`` the figures of :meth:`plot` in ``plots/``) are written into
+        a temporary folder next to ``folder`` which is then renamed to ``folder``: either the
+        complete folder appears or nothing does (a failure removes the temporary folder and any
+        parent folders this call created). An existing ``folder`` is an error (FileExistsError)
+        unless ``overwrite`` is true, in which case it is replaced only once the new folder is
+        complete. ``legs`` and ``formats`` are those of :meth:`plot`.
         """
         target = Path(folder)
         if target.exists() and not overwrite:
             raise FileExistsError(errno.EEXIST, "the results folder exists (choose another folder or overwrite it)", str(target))
-        created = _make_parents(target.parent)
-        tmp: Path | None = None
-        try:
-            tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
-            os.chmod(tmp, 0o777 & ~_umask())
+        figures = self.figures(legs) if plots else None  # before anything is written
+
+        def write(tmp: Path) -> None:
             self._write(tmp)
-            if target.exists():
-                old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
-                os.rename(target, old / "previous")
-                try:
-                    os.rename(tmp, target)
-                except BaseException:
-                    os.rename(old / "previous", target)
-                    raise
-                shutil.rmtree(old, ignore_errors=True)
-            else:
-                os.rename(tmp, target)
-            tmp = None
-        except BaseException:
-            if tmp is not None:
-                shutil.rmtree(tmp, ignore_errors=True)
-            for d in created:
-                try:
-                    d.rmdir()
-                except OSError:
-                    break
-            raise
-        _fsync_dir(target.parent)
+            if figures is not None:
+                (tmp / PLOTS_DIR).mkdir()
+                _save_figures(figures, tmp / PLOTS_DIR, formats)
+
+        _write_folder(target, write)
         self.path = target
         return target
+
+    def figures(self, legs: Sequence[int] | None = None) -> dict[str, Figure]:
+        """The figures of these results by file stem (see :func:`hexadyn.plots.figures`)."""
+        from hexadyn import plots
+
+        return plots.figures(self, plots.DEFAULT_LEGS if legs is None else legs)
+
+    def plot(
+        self,
+        folder: str | os.PathLike | None = None,
+        *,
+        legs: Sequence[int] | None = None,
+        formats: Sequence[str] | None = None,
+    ) -> dict[str, Figure]:
+        """Builds the figures of these results and, with ``folder``, writes them there.
+
+        Returns the matplotlib figures by file stem (``leg0_q_r``, ..., ``gait_diagram``,
+        ``trajectory``, ``averaged_power``, ``energy_breakdown``; see :mod:`hexadyn.plots`).
+        ``legs``: the legs of the per-actuator figures (default 0 and 2, as in Section 6.4).
+        ``formats``: file formats among png (300 dpi), pdf and svg (default png). The folder
+        is written atomically and replaces an existing one: ``results.plot(results.path /
+        "plots")`` regenerates the plots of a saved results folder.
+        """
+        figures = self.figures(legs)
+        if folder is not None:
+            _write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats))
+        return figures
 
     def _write(self, folder: Path) -> None:
         import pyarrow as pa
         import pyarrow.parquet as pq
+
+        from hexadyn import energy
 
         table = pa.Table.from_pandas(self.timeseries, preserve_index=True)
         extra = json.dumps({"units": self.units, "hexadyn_version": self.metadata.get("hexadyn_version")})
@@ -174,6 +204,8 @@ class Results:
         metadata["columns"] = [self.timeseries.index.name, *map(str, self.timeseries.columns)]
         _write_json(folder / METADATA_FILE, metadata)
         _write_json(folder / SUMMARY_FILE, self.summary)
+        _write_csv(folder / POWER_FILE, energy.averaged_power(self))
+        _write_csv(folder / ENERGY_FILE, energy.energy_breakdown(self))
 
     @classmethod
     def load(cls, folder: str | os.PathLike) -> "Results":
@@ -193,6 +225,49 @@ class Results:
         frame = pq.read_table(folder / TIMESERIES_FILE).to_pandas()
         metadata.pop("columns", None)
         return cls(frame, metadata.get("units", {}), summary, metadata, path=folder)
+
+
+def _write_folder(target: Path, write: Callable[[Path], None]) -> None:
+    """Writes a folder atomically: `write` fills a temporary folder next to `target`, which is
+    then renamed to `target`, replacing an existing `target` only once complete. On failure
+    nothing is left: neither the temporary folder nor the parents this call created, and an
+    existing `target` is untouched."""
+    created = _make_parents(target.parent)
+    tmp: Path | None = None
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
+        os.chmod(tmp, 0o777 & ~_umask())
+        write(tmp)
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+            os.rename(target, old / "previous")
+            try:
+                os.rename(tmp, target)
+            except BaseException:
+                os.rename(old / "previous", target)
+                raise
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.rename(tmp, target)
+        tmp = None
+    except BaseException:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+        for d in created:
+            try:
+                d.rmdir()
+            except OSError:
+                break
+        raise
+    _fsync_dir(target.parent)
+
+
+def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence[str] | None) -> None:
+    from hexadyn import plots
+
+    paths = plots.save_figures(figures, folder, plots.DEFAULT_FORMATS if formats is None else formats)
+    for path in paths:
+        _fsync(path)
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -228,6 +303,13 @@ def _write_json(path: Path, value: Any) -> None:
     with open(path, "w", encoding="utf-8") as f:
         json.dump(_json_safe(value), f, indent=2, allow_nan=False)
         f.write("\n")
+        f.flush()
+        os.fsync(f.fileno())
+
+
+def _write_csv(path: Path, table: pd.DataFrame) -> None:
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        table.to_csv(f, float_format="%.9g")
         f.flush()
         os.fsync(f.fileno())
 

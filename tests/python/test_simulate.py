@@ -161,7 +161,7 @@ def test_progress_exception_stops_the_run(sine_file: Path):
 
 def test_save_load_round_trip(sine: Results, tmp_path: Path):
     folder = sine.save(tmp_path / "nested" / "run")
-    assert sorted(p.name for p in folder.iterdir()) == ["metadata.json", "summary.json", "timeseries.parquet"]
+    assert sorted(p.name for p in folder.iterdir()) == ["energy.csv", "metadata.json", "power.csv", "summary.json", "timeseries.parquet"]
     assert [p.name for p in folder.parent.iterdir()] == ["run"], "no temporary folders left"
     loaded = Results.load(folder)
     pd.testing.assert_frame_equal(loaded.timeseries, sine.timeseries, check_exact=True)

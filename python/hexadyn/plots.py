@@ -1,0 +1,367 @@
+"""Figures of a simulation, in the style of the thesis' Chapter 6 (matplotlib, Agg).
+
+Every function takes a :class:`~hexadyn.results.Results` and returns a
+:class:`matplotlib.figure.Figure` built without pyplot: no global state, no window, nothing to
+close, and the user's backend is left alone; files are rendered by Agg (PNG) and the PDF and SVG
+backends. Figures display in Jupyter as they are.
+
+- :func:`joint_figure`: one actuator (leg, joint type): joint position and reference, tracking
+  error, motor current, voltage and electrical power, foot phases shaded (Figs. 6.4-6.15);
+- :func:`gait_diagram`: support, transition and swing bars of every leg over time;
+- :func:`trajectory_figure`: body path in the ground plane X-Y with its reference;
+- :func:`averaged_power_figure`: averaged power per actuator split by foot phase
+  (Tables 6.3-6.6 as a chart);
+- :func:`energy_breakdown_figure`: electrical energy of each actuator split into Joule losses,
+  friction work and mechanical work.
+
+:func:`figures` builds those the results support (the gait diagram and the trajectory need a
+walking scenario) and :func:`save_figures` writes them as 300 dpi PNG and, on request, vector
+PDF or SVG (about twice the time of the PNG files).
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Iterable, Iterator, Mapping, Sequence
+
+import matplotlib
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+
+from hexadyn import energy
+
+if TYPE_CHECKING:
+    from hexadyn.results import Results
+
+#: Legs of the per-actuator figures by default: legs 0 and 2, as in Section 6.4.
+DEFAULT_LEGS = (0, 2)
+#: File formats written by :func:`save_figures` by default.
+DEFAULT_FORMATS = ("png",)
+FORMATS = ("png", "pdf", "svg")
+#: Resolution of the PNG files.
+DPI = 300
+
+#: One style for every figure (paper quality: small serif-free fonts, light grid).
+STYLE = {
+    "font.size": 8,
+    "axes.titlesize": 9,
+    "axes.labelsize": 8,
+    "legend.fontsize": 7,
+    "xtick.labelsize": 7,
+    "ytick.labelsize": 7,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "grid.linewidth": 0.5,
+    "lines.linewidth": 0.9,
+    "axes.prop_cycle": matplotlib.cycler(color=["#1f4e79", "#c0392b", "#2e8b57", "#e67e22", "#7d3c98", "#7f8c8d"]),
+    "figure.constrained_layout.use": True,
+    "savefig.dpi": DPI,
+    "pdf.fonttype": 42,
+    "svg.fonttype": "none",
+}
+#: Colours of the series that recur across figures.
+REFERENCE = "0.25"
+SIMULATED = "#1f4e79"
+#: Shades of grey of the foot phases (Section 6.4: "different shades of gray"); support is white.
+PHASE_SHADES = {"double stance": "0.62", "takeoff": "0.78", "swing": "0.90", "landing": "0.70"}
+#: Colours of the stacked components.
+PHASE_COLOURS = {"support": "#1f4e79", "swing": "#8fb3d9", "transitions": "#e67e22"}
+ENERGY_COLOURS = {"joule_j": "#c0392b", "friction_j": "#7f8c8d", "mechanical_j": "#2e8b57", "magnetic_j": "#7d3c98"}
+ENERGY_LABELS = {"joule_j": "Joule losses", "friction_j": "friction work", "mechanical_j": "mechanical work", "magnetic_j": "magnetic energy change"}
+
+#: Display scale and unit of joint positions per joint type: degrees and millimetres (Figs. 6.4-6.15).
+_POSITION = {"q_r": (180.0 / np.pi, "deg"), "q_v": (1e3, "mm"), "q_h": (1e3, "mm")}
+_JOINT_NAMES = {"q_r": "rotational", "q_v": "vertical", "q_h": "horizontal"}
+
+__all__ = [
+    "DEFAULT_FORMATS",
+    "DEFAULT_LEGS",
+    "averaged_power_figure",
+    "energy_breakdown_figure",
+    "figures",
+    "gait_diagram",
+    "joint_figure",
+    "parse_legs",
+    "save_figures",
+    "trajectory_figure",
+]
+
+
+@contextmanager
+def _style() -> Iterator[None]:
+    with matplotlib.rc_context(STYLE):
+        yield
+
+
+def _title(results: Results) -> str:
+    return str(results.metadata.get("scenario_name") or results.summary.get("scenario") or "")
+
+
+# -------------------------------------------------------------------------------------------------
+# Foot phases
+# -------------------------------------------------------------------------------------------------
+
+
+def _spans(t_end: np.ndarray, dt: float, mask: np.ndarray) -> list[tuple[float, float]]:
+    """(start, width) of the runs of periods (t_end - dt, t_end] where mask holds."""
+    m = np.concatenate([[False], mask, [False]]).astype(np.int8)
+    starts = np.flatnonzero(np.diff(m) == 1)
+    stops = np.flatnonzero(np.diff(m) == -1)
+    return [(t_end[a] - dt, t_end[b - 1] - t_end[a] + dt) for a, b in zip(starts, stops)]
+
+
+def _shade_phases(axes: Iterable, results: Results, leg: int) -> list[Patch]:
+    """Shades the foot phases of a leg on every axis; returns the legend handles."""
+    phases = energy.foot_phases(results)
+    if phases is None:
+        return []
+    t = phases.index.to_numpy()
+    dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
+    code = phases[leg].to_numpy()
+    double = (phases.to_numpy() == energy.SUPPORT).all(axis=1)
+    masks = {
+        "double stance": double,
+        "takeoff": code == energy.TAKEOFF,
+        "swing": code == energy.SWING,
+        "landing": code == energy.LANDING,
+    }
+    spans = {name: _spans(t, dt, mask) for name, mask in masks.items()}
+    for ax in axes:
+        for name, s in spans.items():
+            if s:
+                ax.broken_barh(s, (0, 1), transform=ax.get_xaxis_transform(), facecolor=PHASE_SHADES[name], edgecolor="none", zorder=0)
+    return [Patch(facecolor=PHASE_SHADES[name], label=name) for name, s in spans.items() if s]
+
+
+# -------------------------------------------------------------------------------------------------
+# Figures
+# -------------------------------------------------------------------------------------------------
+
+
+def joint_figure(results: Results, leg: int, joint: str) -> Figure:
+    """Reference, tracking error, current, voltage and power of one actuator (Figs. 6.4-6.15).
+
+    Panels, sharing the time axis (foot phases shaded): the joint position q and its reference
+    (deg for q_r, mm for q_v and q_h), the tracking error q_ref - q, the motor current i (A,
+    sampled at each control instant), the voltage u (V, held over each control period) and the
+    electrical power u i (W, mean over each control period, Eq. 6.7). Without references (an
+    unpowered scenario) the error panel is left out.
+    """
+    _check_leg(leg)
+    if joint not in energy.JOINT_TYPES:
+        raise ValueError(f"joint = {joint!r}; allowed: {', '.join(energy.JOINT_TYPES)}")
+    ts = results.timeseries
+    name = energy.actuator(joint, leg)
+    scale, unit = _POSITION[joint]
+    t = ts.index.to_numpy()
+    has_ref = f"{joint}_ref[{leg}]" in ts.columns
+    p = energy.power(results)[name]
+    with _style():
+        fig = Figure(figsize=(6.3, 7.2 if has_ref else 6.0))
+        axes = fig.subplots(5 if has_ref else 4, 1, sharex=True)
+        it = iter(axes)
+        ax = next(it)
+        ax.plot(t, ts[name] * scale, color=SIMULATED, label="simulated")
+        if has_ref:
+            ax.plot(t, ts[f"{joint}_ref[{leg}]"] * scale, color=REFERENCE, linestyle="--", label="reference")
+        ax.set_ylabel(f"${joint}$ [{unit}]")
+        handles, _ = ax.get_legend_handles_labels()
+        if has_ref:
+            ax = next(it)
+            ax.plot(t, (ts[f"{joint}_ref[{leg}]"] - ts[name]) * scale, color=SIMULATED)
+            ax.set_ylabel(f"tracking error [{unit}]")
+        ax = next(it)
+        ax.plot(t, ts[f"i_{name}"], color=SIMULATED)
+        ax.set_ylabel("current [A]")
+        ax = next(it)
+        ax.plot(t, ts[f"u_{name}"], color=SIMULATED, drawstyle="steps-pre")
+        ax.set_ylabel("voltage [V]")
+        ax = next(it)
+        ax.plot(p.index.to_numpy(), p.to_numpy(), color=SIMULATED, drawstyle="steps-pre")
+        ax.set_ylabel("power [W]")
+        ax.set_xlabel("time [s]")
+        ax.set_xlim(t[0], t[-1])
+        shades = _shade_phases(axes, results, leg)
+        axes[0].legend(handles=handles + shades, loc="lower left", bbox_to_anchor=(0, 1.02), ncol=6, frameon=False, borderaxespad=0)
+        fig.suptitle(f"{_title(results)}: leg {leg}, {_JOINT_NAMES[joint]} joint ${joint}$")
+    return fig
+
+
+def gait_diagram(results: Results) -> Figure:
+    """Gait diagram: for every leg, bars over the time it supports the body (black), its takeoff
+    and landing transitions (grey); the gaps are the swing phases."""
+    phases = energy.foot_phases(results)
+    if phases is None:
+        raise ValueError("gait diagram: these results have no foot phases (not a walking scenario)")
+    t = phases.index.to_numpy()
+    dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
+    legend = {"support": ((energy.SUPPORT,), "black"), "takeoff / landing": ((energy.TAKEOFF, energy.LANDING), "0.6")}
+    with _style():
+        fig = Figure(figsize=(6.3, 2.4))
+        ax = fig.subplots()
+        for row, leg in enumerate(energy.LEGS):
+            for codes, colour in legend.values():
+                ax.broken_barh(_spans(t, dt, np.isin(phases[leg].to_numpy(), codes)), (row - 0.35, 0.7), facecolor=colour, edgecolor="none")
+        ax.set_yticks(range(len(energy.LEGS)), [f"leg {leg}" for leg in energy.LEGS])
+        ax.set_ylim(len(energy.LEGS) - 0.5, -0.5)
+        ax.set_xlim(t[0] - dt, t[-1])
+        ax.set_xlabel("time [s]")
+        ax.grid(axis="y", visible=False)
+        ax.legend(handles=[Patch(facecolor=c, label=n) for n, (_, c) in legend.items()] + [Patch(facecolor="white", edgecolor="0.5", label="swing")], loc="lower left", bbox_to_anchor=(0, 1.02), ncol=3, frameon=False, borderaxespad=0)
+        fig.suptitle(f"{_title(results)}: gait diagram")
+    return fig
+
+
+def trajectory_figure(results: Results) -> Figure:
+    """The body path in the ground plane (X, Y) with its reference and the footholds (equal
+    axes), and below it the XY tracking error over time."""
+    ts = results.timeseries
+    if not {"X_ref", "Y_ref"} <= set(ts.columns):
+        raise ValueError("trajectory: these results have no body reference X_ref, Y_ref (not a walking scenario)")
+    phases = energy.foot_phases(results)
+    t = ts.index.to_numpy()
+    with _style():
+        fig = Figure(figsize=(6.3, 4.4))
+        path, error = fig.subplots(2, 1, height_ratios=[2, 1])
+        for leg in energy.LEGS:
+            # A foothold: where the foot is at the first instant of each support run.
+            support = phases[leg].to_numpy() == energy.SUPPORT
+            first = np.flatnonzero(support & ~np.concatenate([[False], support[:-1]]))
+            x, y = ts[f"foot_x[{leg}]"].to_numpy()[1:][first], ts[f"foot_y[{leg}]"].to_numpy()[1:][first]
+            path.plot(x * 1e3, y * 1e3, linestyle="none", marker="o", markersize=2.5, color="0.6", label="footholds" if leg == 0 else None)
+        path.plot(ts["X_ref"] * 1e3, ts["Y_ref"] * 1e3, color=REFERENCE, linestyle="--", label="reference")
+        path.plot(ts["X"] * 1e3, ts["Y"] * 1e3, color=SIMULATED, label="body")
+        path.plot(ts["X"].iloc[0] * 1e3, ts["Y"].iloc[0] * 1e3, "o", color=SIMULATED, markersize=4, label="start")
+        path.plot(ts["X"].iloc[-1] * 1e3, ts["Y"].iloc[-1] * 1e3, "s", color=SIMULATED, markersize=4, label="end")
+        path.set_aspect("equal", adjustable="datalim")
+        path.set_xlabel("X [mm]")
+        path.set_ylabel("Y [mm]")
+        path.legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=5, frameon=False, borderaxespad=0)
+        error.plot(t, np.hypot(ts["X"] - ts["X_ref"], ts["Y"] - ts["Y_ref"]) * 1e3, color=SIMULATED)
+        error.set_xlim(t[0], t[-1])
+        error.set_xlabel("time [s]")
+        error.set_ylabel("XY tracking error [mm]")
+        fig.suptitle(f"{_title(results)}: body trajectory in the ground plane")
+    return fig
+
+
+def averaged_power_figure(results: Results) -> Figure:
+    """Averaged power per actuator (W), stacked by foot phase when the robot walks."""
+    table = energy.averaged_power(results)
+    phases = [p for p in energy.PHASE_GROUPS if p in table.index.get_level_values("phase")] or [energy.ALL]
+    parts = pd.DataFrame({p: _per_actuator(table.loc[p]) for p in phases})
+    colours = {**PHASE_COLOURS, energy.ALL: SIMULATED}
+    with _style():
+        fig = Figure(figsize=(6.3, 3.0))
+        ax = fig.subplots()
+        _stacked_actuator_bars(ax, parts, {p: colours[p] for p in phases}, {p: p for p in phases})
+        ax.set_ylabel("averaged power [W]")
+        fig.suptitle(f"{_title(results)}: averaged power per actuator (total {table.loc[(energy.ALL, energy.TOTAL), energy.TOTAL]:.3g} W)")
+    return fig
+
+
+def energy_breakdown_figure(results: Results) -> Figure:
+    """Energy of each actuator (J): Joule losses, friction work and mechanical work stacked
+    (negative parts below zero) and the electrical energy drawn as a marker, their sum."""
+    b = energy.energy_breakdown(results)
+    components = [c for c in ENERGY_COLOURS if c != "magnetic_j" or b[c].any()]
+    with _style():
+        fig = Figure(figsize=(6.3, 3.0))
+        ax = fig.subplots()
+        x = _stacked_actuator_bars(ax, b[components], {c: ENERGY_COLOURS[c] for c in components}, ENERGY_LABELS)
+        ax.plot(x, b["electrical_j"], linestyle="none", marker="D", markersize=3.5, color="black", label="electrical energy")
+        ax.legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=5, frameon=False, borderaxespad=0)
+        ax.set_ylabel("energy [J]")
+        fig.suptitle(f"{_title(results)}: energy per actuator (electrical {b['electrical_j'].sum():.4g} J)")
+    return fig
+
+
+def _per_actuator(block: pd.DataFrame) -> pd.Series:
+    """A (leg x joint type) block of :func:`energy.averaged_power` as one value per actuator."""
+    return pd.Series({energy.actuator(j, leg): block.loc[leg, j] for leg in energy.LEGS for j in energy.JOINT_TYPES})
+
+
+def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], labels: Mapping[str, str]) -> np.ndarray:
+    """Bars of the 18 actuators grouped by leg, the columns of `parts` stacked (positive parts
+    upwards from zero, negative ones downwards); returns the bar positions."""
+    x = np.array([4 * leg + k for leg in energy.LEGS for k in range(len(energy.JOINT_TYPES))], dtype=float)
+    up = np.zeros(len(x))
+    down = np.zeros(len(x))
+    for column in parts.columns:
+        v = parts[column].to_numpy()
+        base = np.where(v >= 0, up, down)
+        ax.bar(x, v, 0.8, bottom=base, color=colours[column], label=labels[column])
+        up += np.clip(v, 0, None)
+        down += np.clip(v, None, 0)
+    ax.axhline(0, color="black", linewidth=0.6)
+    ax.set_xticks(x, [j.replace("q_", "") for _ in energy.LEGS for j in energy.JOINT_TYPES])
+    ax.tick_params(axis="x", length=0)
+    ax.grid(axis="x", visible=False)
+    groups = ax.secondary_xaxis(-0.09)
+    groups.set_xticks([4 * leg + 1 for leg in energy.LEGS], [f"leg {leg}" for leg in energy.LEGS])
+    groups.tick_params(length=0)
+    groups.spines["bottom"].set_visible(False)
+    ax.legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=5, frameon=False, borderaxespad=0)
+    return x
+
+
+# -------------------------------------------------------------------------------------------------
+# All figures of a run
+# -------------------------------------------------------------------------------------------------
+
+
+def parse_legs(text: str) -> tuple[int, ...]:
+    """Legs from the command line: ``"0,2"`` or ``"all"``."""
+    if text.strip().lower() == "all":
+        return energy.LEGS
+    try:
+        legs = tuple(int(s) for s in text.split(","))
+    except ValueError:
+        raise ValueError(f"legs = {text!r}; allowed: comma-separated legs 0..5 (e.g. 0,2) or all") from None
+    for leg in legs:
+        _check_leg(leg)
+    return tuple(dict.fromkeys(legs))
+
+
+def _check_leg(leg: int) -> None:
+    if leg not in energy.LEGS:
+        raise ValueError(f"leg = {leg!r}; allowed: 0..5")
+
+
+def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, Figure]:
+    """The figures the results support, by file stem: ``leg0_q_r`` ... for the given legs, then
+    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``averaged_power`` and
+    ``energy_breakdown``."""
+    for leg in legs:
+        _check_leg(leg)
+    out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in energy.JOINT_TYPES}
+    if energy.foot_phases(results) is not None:
+        out["gait_diagram"] = gait_diagram(results)
+    if "X_ref" in results.timeseries.columns:
+        out["trajectory"] = trajectory_figure(results)
+    out["averaged_power"] = averaged_power_figure(results)
+    out["energy_breakdown"] = energy_breakdown_figure(results)
+    return out
+
+
+def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS) -> list[Path]:
+    """Writes every figure as ``folder/<stem>.<format>`` (PNG at 300 dpi); returns the paths.
+
+    The folder must exist. Use :meth:`hexadyn.Results.plot` or :meth:`hexadyn.Results.save` to
+    write a complete plots folder atomically.
+    """
+    bad = [f for f in formats if f not in FORMATS]
+    if bad or not formats:
+        raise ValueError(f"plot formats = {', '.join(formats) or 'none'}; allowed: one or more of {', '.join(FORMATS)}")
+    folder = Path(folder)
+    paths = []
+    with _style():
+        for stem, fig in figs.items():
+            for fmt in formats:
+                path = folder / f"{stem}.{fmt}"
+                fig.savefig(path, format=fmt, dpi=DPI)
+                paths.append(path)
+    return paths
