@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +16,8 @@ import hexadyn
 from hexadyn import Results, _core
 from hexadyn import results as results_module
 from hexadyn.cli import DEFAULT_SCENARIO, cli
+
+from conftest import shortened
 
 SHIPPED = {
     "stand_six_legs",
@@ -42,16 +43,6 @@ SHIPPED = {
     "soft_ground_plain",
     "gait_changes",
 }
-
-
-def shortened(name: str, folder: Path, duration: float = 0.2) -> Path:
-    """A copy of a shipped scenario with duration_s replaced (keeps the tests fast)."""
-    text = (hexadyn.SCENARIOS_DIR / f"{name}.toml").read_text()
-    text, n = re.subn(r"(?m)^duration_s = .*$", f"duration_s = {duration}", text)
-    assert n == 1
-    path = folder / f"{name}.toml"
-    path.write_text(text)
-    return path
 
 
 @pytest.fixture(scope="module")

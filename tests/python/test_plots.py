@@ -1,0 +1,137 @@
+"""Figures (hexadyn.plots), Results.plot and the plots written by `hexadyn simulate` and
+`hexadyn plot`: every PNG must hold drawn content, and a failure must leave nothing behind."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from matplotlib.colors import to_rgb
+from matplotlib.figure import Figure
+from matplotlib.image import imread
+
+import hexadyn
+from hexadyn import Results, plots
+from hexadyn.cli import cli
+
+from conftest import shortened
+
+WALK_STEMS = {"gait_diagram", "trajectory", "averaged_power", "energy_breakdown"}
+
+
+def assert_drawn(png: Path, colour: str | None = None) -> None:
+    """The PNG is a 300 dpi figure with a substantial drawn part and several colours, and holds
+    `colour` (a data series) over a visible number of pixels."""
+    image = imread(png)[..., :3]
+    height, width = image.shape[:2]
+    assert width >= 6 * 300 * 0.95, f"{png.name}: {width} px wide, not 300 dpi"
+    pixels = image.reshape(-1, 3)
+    background = np.all(pixels > 0.99, axis=1)
+    assert background.mean() < 0.97, f"{png.name}: {100 * (1 - background.mean()):.1f} % drawn"
+    assert (~background).sum() > 20000, png.name
+    levels = (pixels * 15).round().astype(np.int32)
+    colours = np.unique(levels[:, 0] * 256 + levels[:, 1] * 16 + levels[:, 2]).size
+    assert colours >= 8, f"{png.name}: only {colours} colours"
+    if colour is not None:
+        near = np.all(np.abs(pixels - np.array(to_rgb(colour))) < 0.04, axis=1)
+        assert near.sum() > 1000, f"{png.name}: {near.sum()} pixels of {colour}"
+
+
+def test_results_plot_writes_every_figure(walk: Results, tmp_path: Path):
+    figures = walk.plot(tmp_path / "plots", legs=[2])
+    assert set(figures) == {"leg2_q_r", "leg2_q_v", "leg2_q_h"} | WALK_STEMS
+    assert all(isinstance(f, Figure) for f in figures.values())
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == sorted(f"{s}.png" for s in figures)
+    for stem in figures:
+        assert_drawn(tmp_path / "plots" / f"{stem}.png", plots.SIMULATED if stem.startswith("leg") or stem == "trajectory" else None)
+    # The joint figure: position, tracking error, current, voltage, power, labelled with units.
+    labels = [ax.get_ylabel() for ax in figures["leg2_q_v"].axes if ax.get_ylabel()]
+    assert labels == ["$q_v$ [mm]", "tracking error [mm]", "current [A]", "voltage [V]", "power [W]"]
+    assert figures["leg2_q_v"].axes[-1].get_xlabel() == "time [s]"
+    legend = [t.get_text() for t in figures["leg2_q_v"].axes[0].get_legend().get_texts()]
+    assert legend[:2] == ["simulated", "reference"] and {"swing", "takeoff", "landing", "double stance"} <= set(legend)
+    # Regenerating replaces the folder's content atomically.
+    walk.plot(tmp_path / "plots", legs=[], formats=["svg", "pdf"])
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == sorted(f"{s}.{f}" for s in WALK_STEMS for f in ("svg", "pdf"))
+    assert (tmp_path / "plots" / "gait_diagram.pdf").read_bytes().startswith(b"%PDF")
+    assert [p.name for p in tmp_path.iterdir()] == ["plots"]
+
+
+def test_parse_legs():
+    assert plots.parse_legs("all") == (0, 1, 2, 3, 4, 5)
+    assert plots.parse_legs("2,0,2") == (2, 0)
+    for bad in ["6", "-1", "0;2", ""]:
+        with pytest.raises(ValueError, match="allowed: "):
+            plots.parse_legs(bad)
+
+
+def test_plot_errors_leave_nothing(walk: Results, tmp_path: Path, monkeypatch):
+    with pytest.raises(ValueError, match=r"leg = 6; allowed: 0\.\.5"):
+        walk.plot(tmp_path / "p", legs=[6])
+    with pytest.raises(ValueError, match="allowed: one or more of png, pdf, svg"):
+        walk.plot(tmp_path / "p", formats=["jpeg"])
+    with pytest.raises(ValueError, match="joint = 'q_x'"):
+        plots.joint_figure(walk, 0, "q_x")
+    assert list(tmp_path.iterdir()) == []
+
+    # A failure while writing the figures: neither the results folder nor a temporary folder.
+    real = plots.save_figures
+
+    def failing(figures, folder, formats):
+        real(dict(list(figures.items())[:1]), folder, formats)
+        raise OSError(28, "No space left on device", str(folder))
+
+    monkeypatch.setattr(plots, "save_figures", failing)
+    with pytest.raises(OSError, match="No space left"):
+        walk.save(tmp_path / "run", plots=True, legs=[0])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_figures_without_a_gait(tmp_path: Path):
+    r = hexadyn.simulate(shortened("unpowered_lugre", tmp_path, 0.3), progress=False)
+    figures = plots.figures(r, legs=[4])
+    assert set(figures) == {"leg4_q_r", "leg4_q_v", "leg4_q_h", "averaged_power", "energy_breakdown"}
+    labels = [ax.get_ylabel() for ax in figures["leg4_q_v"].axes]
+    assert "tracking error [mm]" not in labels, "no reference without control"
+    with pytest.raises(ValueError, match="not a walking scenario"):
+        plots.gait_diagram(r)
+    with pytest.raises(ValueError, match="not a walking scenario"):
+        plots.trajectory_figure(r)
+
+
+def test_cli_simulate_and_plot(walk_file: Path, tmp_path: Path):
+    out = tmp_path / "walk"
+    runner = CliRunner()
+    result = runner.invoke(cli, ["simulate", str(walk_file), "--out", str(out), "--no-progress"], prog_name="hexadyn")
+    assert result.exit_code == 0, result.output
+    assert "averaged power per actuator (W)" in result.output and "specific resistance" in result.output
+    assert "by foot phase: support" in result.output
+    assert f"plots       {out / 'plots'} (10 files)" in result.output
+    stems = {f"leg{leg}_{j}" for leg in (0, 2) for j in ("q_r", "q_v", "q_h")} | WALK_STEMS
+    assert {p.name for p in (out / "plots").iterdir()} == {f"{s}.png" for s in stems}
+    assert_drawn(out / "plots" / "leg0_q_h.png", plots.SIMULATED)
+    assert sorted(p.name for p in out.iterdir()) == ["energy.csv", "metadata.json", "plots", "power.csv", "summary.json", "timeseries.parquet"]
+
+    # `hexadyn plot` regenerates the plots of a results folder.
+    result = runner.invoke(cli, ["plot", str(out), "--legs", "5", "--formats", "png,svg"], prog_name="hexadyn")
+    assert result.exit_code == 0, result.output
+    assert "7 figures x 2 formats" in result.output
+    assert {p.name for p in (out / "plots").glob("leg*")} == {f"leg5_{j}.{f}" for j in ("q_r", "q_v", "q_h") for f in ("png", "svg")}
+    assert_drawn(out / "plots" / "leg5_q_r.png", plots.SIMULATED)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["walk"], "no temporary folder left"
+
+    for args, message in [
+        (["plot", str(out), "--legs", "7"], "leg = 7"),
+        (["plot", str(out), "--formats", "gif"], "gif"),
+        (["plot", str(tmp_path / "missing")], "no such results folder"),
+        (["plot", str(tmp_path)], "not a hexadyn results folder"),
+    ]:
+        result = runner.invoke(cli, args, prog_name="hexadyn")
+        assert result.exit_code != 0 and message in result.output and "Traceback" not in result.output, (args, result.output)
+
+    quiet = tmp_path / "quiet"
+    result = runner.invoke(cli, ["simulate", str(walk_file), "--out", str(quiet), "--no-progress", "--no-plots"], prog_name="hexadyn")
+    assert result.exit_code == 0, result.output
+    assert not (quiet / "plots").exists() and (quiet / "power.csv").is_file()
