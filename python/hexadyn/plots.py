@@ -86,12 +86,14 @@ __all__ = [
     "joint_figure",
     "parse_legs",
     "save_figures",
+    "style",
     "trajectory_figure",
 ]
 
 
 @contextmanager
-def _style() -> Iterator[None]:
+def style() -> Iterator[None]:
+    """The rc settings of every hexadyn figure (:data:`STYLE`), while building and saving."""
     with matplotlib.rc_context(STYLE):
         yield
 
@@ -159,7 +161,7 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
     t = ts.index.to_numpy()
     has_ref = f"{joint}_ref[{leg}]" in ts.columns
     p = energy.power(results)[name]
-    with _style():
+    with style():
         fig = Figure(figsize=(6.3, 7.2 if has_ref else 6.0))
         axes = fig.subplots(5 if has_ref else 4, 1, sharex=True)
         it = iter(axes)
@@ -199,7 +201,7 @@ def gait_diagram(results: Results) -> Figure:
     t = phases.index.to_numpy()
     dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
     legend = {"support": ((energy.SUPPORT,), "black"), "takeoff / landing": ((energy.TAKEOFF, energy.LANDING), "0.6")}
-    with _style():
+    with style():
         fig = Figure(figsize=(6.3, 2.4))
         ax = fig.subplots()
         for row, leg in enumerate(energy.LEGS):
@@ -223,7 +225,7 @@ def trajectory_figure(results: Results) -> Figure:
         raise ValueError("trajectory: these results have no body reference X_ref, Y_ref (not a walking scenario)")
     phases = energy.foot_phases(results)
     t = ts.index.to_numpy()
-    with _style():
+    with style():
         fig = Figure(figsize=(6.3, 4.4))
         path, error = fig.subplots(2, 1, height_ratios=[2, 1])
         for leg in energy.LEGS:
@@ -254,7 +256,7 @@ def averaged_power_figure(results: Results) -> Figure:
     phases = [p for p in energy.PHASE_GROUPS if p in table.index.get_level_values("phase")] or [energy.ALL]
     parts = pd.DataFrame({p: _per_actuator(table.loc[p]) for p in phases})
     colours = {**PHASE_COLOURS, energy.ALL: SIMULATED}
-    with _style():
+    with style():
         fig = Figure(figsize=(6.3, 3.0))
         ax = fig.subplots()
         _stacked_actuator_bars(ax, parts, {p: colours[p] for p in phases}, {p: p for p in phases})
@@ -268,7 +270,7 @@ def energy_breakdown_figure(results: Results) -> Figure:
     (negative parts below zero) and the electrical energy drawn as a marker, their sum."""
     b = energy.energy_breakdown(results)
     components = [c for c in ENERGY_COLOURS if c != "magnetic_j" or b[c].any()]
-    with _style():
+    with style():
         fig = Figure(figsize=(6.3, 3.0))
         ax = fig.subplots()
         x = _stacked_actuator_bars(ax, b[components], {c: ENERGY_COLOURS[c] for c in components}, ENERGY_LABELS)
@@ -358,7 +360,7 @@ def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequen
         raise ValueError(f"plot formats = {', '.join(formats) or 'none'}; allowed: one or more of {', '.join(FORMATS)}")
     folder = Path(folder)
     paths = []
-    with _style():
+    with style():
         for stem, fig in figs.items():
             for fmt in formats:
                 path = folder / f"{stem}.{fmt}"

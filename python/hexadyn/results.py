@@ -41,7 +41,7 @@ PLOTS_DIR = "plots"
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
 
-__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE", "POWER_FILE", "ENERGY_FILE", "PLOTS_DIR"]
+__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE", "POWER_FILE", "ENERGY_FILE", "PLOTS_DIR", "write_folder", "write_csv"]
 
 
 class Results:
@@ -157,7 +157,7 @@ class Results:
                 (tmp / PLOTS_DIR).mkdir()
                 _save_figures(figures, tmp / PLOTS_DIR, formats)
 
-        _write_folder(target, write)
+        write_folder(target, write)
         self.path = target
         return target
 
@@ -185,7 +185,7 @@ class Results:
         """
         figures = self.figures(legs)
         if folder is not None:
-            _write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats))
+            write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats))
         return figures
 
     def _write(self, folder: Path) -> None:
@@ -198,14 +198,13 @@ class Results:
         extra = json.dumps({"units": self.units, "hexadyn_version": self.metadata.get("hexadyn_version")})
         table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"hexadyn": extra.encode()})
         pq.write_table(table, folder / TIMESERIES_FILE)
-        _fsync(folder / TIMESERIES_FILE)
         metadata = dict(self.metadata)
         metadata["units"] = self.units
         metadata["columns"] = [self.timeseries.index.name, *map(str, self.timeseries.columns)]
         _write_json(folder / METADATA_FILE, metadata)
         _write_json(folder / SUMMARY_FILE, self.summary)
-        _write_csv(folder / POWER_FILE, energy.averaged_power(self))
-        _write_csv(folder / ENERGY_FILE, energy.energy_breakdown(self))
+        write_csv(folder / POWER_FILE, energy.averaged_power(self))
+        write_csv(folder / ENERGY_FILE, energy.energy_breakdown(self))
 
     @classmethod
     def load(cls, folder: str | os.PathLike) -> "Results":
@@ -227,17 +226,20 @@ class Results:
         return cls(frame, metadata.get("units", {}), summary, metadata, path=folder)
 
 
-def _write_folder(target: Path, write: Callable[[Path], None]) -> None:
-    """Writes a folder atomically: `write` fills a temporary folder next to `target`, which is
-    then renamed to `target`, replacing an existing `target` only once complete. On failure
-    nothing is left: neither the temporary folder nor the parents this call created, and an
-    existing `target` is untouched."""
+def write_folder(target: Path, write: Callable[[Path], None]) -> None:
+    """Writes a folder atomically: `write` fills a temporary folder next to `target`, whose
+    files are then synced to disk and which is renamed to `target`, replacing an existing
+    `target` only once complete. On failure nothing is left: neither the temporary folder nor
+    the parents this call created, and an existing `target` is untouched."""
     created = _make_parents(target.parent)
     tmp: Path | None = None
     try:
         tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
         os.chmod(tmp, 0o777 & ~_umask())
         write(tmp)
+        for path in sorted(tmp.rglob("*")):
+            if path.is_file():
+                _fsync(path)
         if target.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
             os.rename(target, old / "previous")
@@ -265,9 +267,7 @@ def _write_folder(target: Path, write: Callable[[Path], None]) -> None:
 def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence[str] | None) -> None:
     from hexadyn import plots
 
-    paths = plots.save_figures(figures, folder, plots.DEFAULT_FORMATS if formats is None else formats)
-    for path in paths:
-        _fsync(path)
+    plots.save_figures(figures, folder, plots.DEFAULT_FORMATS if formats is None else formats)
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -303,15 +303,12 @@ def _write_json(path: Path, value: Any) -> None:
     with open(path, "w", encoding="utf-8") as f:
         json.dump(_json_safe(value), f, indent=2, allow_nan=False)
         f.write("\n")
-        f.flush()
-        os.fsync(f.fileno())
 
 
-def _write_csv(path: Path, table: pd.DataFrame) -> None:
+def write_csv(path: Path, table: pd.DataFrame) -> None:
+    """Writes a table as CSV (floats with 9 significant digits)."""
     with open(path, "w", encoding="utf-8", newline="") as f:
         table.to_csv(f, float_format="%.9g")
-        f.flush()
-        os.fsync(f.fileno())
 
 
 def _fsync(path: Path) -> None:

@@ -1,0 +1,282 @@
+"""Friction-model comparison of the validation walk (thesis Section 6.4, Tables 6.3-6.6 and
+Fig. 6.19).
+
+One scenario (by default the validation case of Table 6.2) is run with each friction model of
+:data:`MODELS` (no friction, dry/viscous Eq. 6.1, LuGre, dry/viscous with the load dependence of
+the horizontal joints Eq. 5.12) at each velocity V_x, in parallel on the local cores. The
+scenario fields are changed through the overrides of :func:`hexadyn.simulate`; the step period
+and the number of steps stay those of the scenario, so the step length grows with V_x as in
+Section 6.3.
+
+Outputs (:func:`compare_friction`, written atomically by :func:`save`):
+
+- ``power_by_model.csv``: averaged power per leg and joint type for every velocity and model;
+  :func:`joint_tables` turns it into the layout of Tables 6.3-6.6 (one table per joint type,
+  rows legs 0-5 and total, one column per model);
+- ``robot_power.csv``: per velocity and model the averaged robot power, the electrical and
+  friction energies, the distance walked, the specific resistance ξ (Eq. 6.6), the friction
+  share (friction work over electrical energy) and the share of the power due to friction
+  (1 - P_none / P_model, Section 6.6: "more than 80 %");
+- ``fit.csv``: per model α and β of P = α + β V_x (Eq. 6.8) and the asymptote β / (m g) of ξ;
+- ``plots/``: Fig. 6.19 (a) power and (b) specific resistance versus velocity with the fits,
+  and the averaged power per actuator and model (Tables 6.3-6.6 as bar charts).
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from hexadyn import energy, plots
+
+#: Friction models of the comparison: name -> scenario overrides (Section 6.1 and 6.4.4).
+MODELS: dict[str, dict[str, Any]] = {
+    "none": {"model.friction": "none", "model.load_dependence": False},
+    "dry_viscous": {"model.friction": "dry_viscous", "model.load_dependence": False},
+    "lugre": {"model.friction": "lugre", "model.load_dependence": False},
+    "dry_viscous_load": {"model.friction": "dry_viscous", "model.load_dependence": True},
+}
+#: Legend labels of the models.
+MODEL_LABELS = {
+    "none": "no friction",
+    "dry_viscous": "dry/viscous",
+    "lugre": "LuGre",
+    "dry_viscous_load": "dry/viscous + load",
+}
+#: Velocities V_x of Table 6.2 and Fig. 6.19 (m/s).
+DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
+#: Scenario field of the forward velocity.
+VELOCITY_FIELD = "gait.heading.vx_m_s"
+POWER_FILE = "power_by_model.csv"
+ROBOT_FILE = "robot_power.csv"
+FIT_FILE = "fit.csv"
+
+__all__ = [
+    "DEFAULT_VELOCITIES",
+    "MODELS",
+    "Comparison",
+    "compare_friction",
+    "figures",
+    "joint_tables",
+    "save",
+]
+
+
+@dataclass
+class Comparison:
+    """The tables of a friction-model comparison (see the module doc for the columns)."""
+
+    scenario: str
+    #: Averaged power per (velocity_m_s, model, leg) and joint type q_r, q_v, q_h, total (W).
+    power: pd.DataFrame
+    #: One row per (velocity_m_s, model): robot power, energies, distance, ξ, friction shares.
+    robot: pd.DataFrame
+    #: One row per model: alpha_w, beta_n, xi_asymptote (β / (m g)), mass_kg.
+    fit: pd.DataFrame
+    #: The velocity of the Tables 6.3-6.6 layout (m/s).
+    table_velocity: float
+
+
+def _run(scenario: str, model: str, velocity: float) -> dict[str, Any]:
+    """One run (in a worker process): its averaged power table and robot figures."""
+    import hexadyn
+
+    name = f"{Path(scenario).stem}_{model}_{velocity * 100:g}cm"
+    overrides = {**MODELS[model], VELOCITY_FIELD: velocity, "scenario.name": name}
+    try:
+        results = hexadyn.simulate(scenario, progress=False, overrides=overrides)
+    except ValueError as exc:
+        raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
+    s = results.summary
+    return {
+        "model": model,
+        "velocity_m_s": velocity,
+        "power": energy.averaged_power(results).loc[energy.ALL],
+        "robot": {
+            "average_power_w": s["average_power_w"],
+            "energy_electrical_j": s["energy_electrical_j"],
+            "energy_friction_j": s["energy_friction_j"],
+            "distance_m": s["distance_walked_m"],
+            "duration_s": s["duration_s"],
+            "mass_kg": s["robot_mass_kg"],
+            "specific_resistance": s.get("specific_resistance", np.nan),
+            "friction_share": s["friction_share"],
+        },
+    }
+
+
+def compare_friction(
+    scenario: str | os.PathLike,
+    velocities: Sequence[float] = DEFAULT_VELOCITIES,
+    *,
+    models: Sequence[str] = tuple(MODELS),
+    jobs: int | None = None,
+    progress: bool | Callable[[int, int], object] = True,
+) -> Comparison:
+    """Runs `scenario` with every friction model at every velocity (m/s) and tabulates them.
+
+    Args:
+        scenario: a walking scenario file or shipped scenario name (constant heading).
+        velocities: forward velocities V_x (m/s), at least two distinct ones for the fit.
+        models: names among :data:`MODELS`.
+        jobs: worker processes (default: the number of CPUs, at most the number of runs).
+        progress: a tqdm bar over the runs (True), none (False), or ``progress(done, total)``.
+
+    Raises ValueError naming the model, the velocity and the field for a run the scenario
+    cannot take (e.g. a velocity whose stride does not fit the workspace).
+    """
+    import hexadyn
+
+    path = hexadyn.resolve_scenario(scenario)
+    velocities = _check_velocities(velocities)
+    unknown = [m for m in models if m not in MODELS]
+    if unknown or not models:
+        raise ValueError(f"friction models {', '.join(map(str, unknown)) or 'none given'}; allowed: {', '.join(MODELS)}")
+    runs = [(m, v) for v in velocities for m in models]
+    workers = max(1, min(jobs or os.cpu_count() or 1, len(runs)))
+    outputs = []
+    bar = _progress_bar(progress, len(runs))
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        pending = {pool.submit(_run, os.fspath(path), m, v) for m, v in runs}
+        try:
+            while pending:
+                done, pending = wait(pending, return_when=FIRST_EXCEPTION)
+                for future in done:
+                    outputs.append(future.result())
+                    bar(len(outputs))
+        except BaseException:
+            for future in pending:
+                future.cancel()
+            raise
+        finally:
+            bar(None)
+    return _tabulate(Path(path).stem, outputs, velocities, list(models), _scenario_velocity(path))
+
+
+def _check_velocities(velocities: Sequence[float]) -> list[float]:
+    v = [float(x) for x in velocities]
+    if len(set(v)) < 2 or any(not x > 0 for x in v):
+        raise ValueError(f"velocities {v}; allowed: at least two distinct positive velocities (m/s) for the fit of Eq. 6.8")
+    return sorted(set(v))
+
+
+def _scenario_velocity(path: Path) -> float | None:
+    heading = energy._toml(path.read_text(encoding="utf-8"), f"{path}").get("gait", {}).get("heading", {})
+    value = heading.get("vx_m_s")
+    return float(value) if isinstance(value, (int, float)) else None
+
+
+def _progress_bar(progress: bool | Callable[[int, int], object], total: int) -> Callable[[int | None], None]:
+    """A callback taking the number of finished runs (None when finished)."""
+    if callable(progress):
+        return lambda n: None if n is None else progress(n, total)
+    if not progress:
+        return lambda n: None
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=total, desc="friction models", unit="run")
+
+    def update(n: int | None) -> None:
+        if n is None:
+            bar.close()
+        else:
+            bar.update(n - bar.n)
+
+    return update
+
+
+def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: list[str], own_velocity: float | None) -> Comparison:
+    order = {(v, m): k for k, (v, m) in enumerate((v, m) for v in velocities for m in models)}
+    outputs = sorted(outputs, key=lambda o: order[(o["velocity_m_s"], o["model"])])
+    power = pd.concat({(o["velocity_m_s"], o["model"]): o["power"] for o in outputs}, names=["velocity_m_s", "model", "leg"])
+    robot = pd.DataFrame([o["robot"] for o in outputs], index=pd.MultiIndex.from_tuples([(o["velocity_m_s"], o["model"]) for o in outputs], names=["velocity_m_s", "model"]))
+    if "none" in models:
+        p_none = robot.xs("none", level="model")["average_power_w"]
+        robot["friction_power_share"] = 1 - robot.index.get_level_values("velocity_m_s").map(p_none).to_numpy() / robot["average_power_w"].to_numpy()
+    fit_rows = {}
+    for m in models:
+        r = robot.xs(m, level="model")
+        alpha, beta = energy.fit_power_velocity(r.index.to_numpy(), r["average_power_w"].to_numpy())
+        mass = float(r["mass_kg"].iloc[0])
+        fit_rows[m] = {"alpha_w": alpha, "beta_n": beta, "xi_asymptote": beta / (mass * energy.G), "mass_kg": mass}
+    fit = pd.DataFrame.from_dict(fit_rows, orient="index").rename_axis("model")
+    table_velocity = own_velocity if own_velocity in velocities else velocities[0]
+    return Comparison(name, power, robot, fit, table_velocity)
+
+
+def joint_tables(comparison: Comparison, velocity: float | None = None) -> dict[str, pd.DataFrame]:
+    """Tables 6.3-6.6: for each joint type, the averaged power (W) per leg (rows 0-5, total)
+    and friction model (columns), at `velocity` (default: the comparison's table velocity)."""
+    v = comparison.table_velocity if velocity is None else velocity
+    at = comparison.power.xs(v, level="velocity_m_s")
+    return {j: at[j].unstack("model")[list(at.index.unique("model"))].rename_axis(index="leg", columns=None) for j in energy.JOINT_TYPES}
+
+
+def figures(comparison: Comparison) -> dict[str, Figure]:
+    """Fig. 6.19 (a) ``power_velocity`` and (b) ``specific_resistance`` with the α/β fits, and
+    ``power_by_model``: the averaged power per actuator and model at the table velocity."""
+    robot, fit = comparison.robot, comparison.fit
+    models = list(fit.index)
+    v_all = np.array(sorted(robot.index.unique("velocity_m_s")))
+    v_line = np.linspace(v_all.min() * 0.9, v_all.max() * 1.05, 100)
+    out = {}
+    with plots.style():
+        for stem, ylabel, value, curve in [
+            ("power_velocity", "averaged robot power [W]", "average_power_w", lambda f, v: f.alpha_w + f.beta_n * v),
+            ("specific_resistance", "specific resistance ξ [-]", "specific_resistance", lambda f, v: energy.specific_resistance_fit(f.alpha_w, f.beta_n, f.mass_kg, v)),
+        ]:
+            fig = Figure(figsize=(4.5, 3.2))
+            ax = fig.subplots()
+            for k, m in enumerate(models):
+                r = robot.xs(m, level="model")
+                f = fit.loc[m]
+                colour = plots.STYLE["axes.prop_cycle"].by_key()["color"][k]
+                ax.plot(r.index.to_numpy() * 100, r[value], linestyle="none", marker="os^Dv"[k % 5], color=colour, label=MODEL_LABELS[m])
+                ax.plot(v_line * 100, curve(f, v_line), color=colour, linewidth=0.8)
+            ax.set_xlabel("velocity $V_x$ [cm/s]")
+            ax.set_ylabel(ylabel)
+            ax.legend(frameon=False)
+            fig.suptitle(f"{comparison.scenario}: {ylabel.split(' [')[0]} (markers: runs, lines: Eq. 6.8/6.11 fit)")
+            out[stem] = fig
+        tables = joint_tables(comparison)
+        fig = Figure(figsize=(6.3, 6.0))
+        axes = fig.subplots(3, 1, sharex=True)
+        width = 0.8 / len(models)
+        x = np.arange(len(energy.LEGS) + 1)
+        for ax, (joint, table) in zip(axes, tables.items()):
+            for k, m in enumerate(models):
+                ax.bar(x - 0.4 + width * (k + 0.5), table[m].to_numpy(), width, label=MODEL_LABELS[m])
+            ax.set_ylabel(f"${joint}$ power [W]")
+            ax.grid(axis="x", visible=False)
+        axes[-1].set_xticks(x, [f"leg {leg}" for leg in energy.LEGS] + ["total"])
+        axes[0].legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=len(models), frameon=False, borderaxespad=0)
+        fig.suptitle(f"{comparison.scenario}: averaged power per actuator, $V_x$ = {comparison.table_velocity * 100:g} cm/s (Tables 6.3-6.6)")
+        out["power_by_model"] = fig
+    return out
+
+
+def save(comparison: Comparison, folder: str | os.PathLike, *, overwrite: bool = False, formats: Sequence[str] = plots.DEFAULT_FORMATS) -> Path:
+    """Writes the tables and figures of a comparison into `folder`, atomically."""
+    from hexadyn.results import write_csv, write_folder
+
+    target = Path(folder)
+    if target.exists() and not overwrite:
+        raise FileExistsError(17, "the comparison folder exists (choose another folder or overwrite it)", str(target))
+    figs = figures(comparison)
+
+    def write(tmp: Path) -> None:
+        write_csv(tmp / POWER_FILE, comparison.power)
+        write_csv(tmp / ROBOT_FILE, comparison.robot)
+        write_csv(tmp / FIT_FILE, comparison.fit)
+        (tmp / "plots").mkdir()
+        plots.save_figures(figs, tmp / "plots", formats)
+
+    write_folder(target, write)
+    return target
