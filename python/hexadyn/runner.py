@@ -11,7 +11,7 @@ from __future__ import annotations
 import errno
 import os
 from pathlib import Path
-from typing import Callable, Union
+from typing import Any, Callable, Mapping, Union
 
 from hexadyn.results import Results
 
@@ -55,6 +55,7 @@ def simulate(
     progress: Progress = True,
     *,
     overwrite: bool = False,
+    overrides: Mapping[str, Any] | None = None,
 ) -> Results:
     """Runs a scenario and returns its :class:`~hexadyn.results.Results`.
 
@@ -65,6 +66,10 @@ def simulate(
         progress: True for a tqdm progress bar over the simulated time (on stderr), False for
             none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
         overwrite: replace an existing ``out`` folder.
+        overrides: scenario fields set from outside the file, by dotted name, e.g.
+            ``{"model.friction": "dry_viscous", "gait.heading.vx_m_s": 0.01}`` (values: bool,
+            int, float, str, lists and dicts of those). The results' metadata then holds the
+            effective scenario text.
 
     Raises:
         FileNotFoundError: no such scenario.
@@ -77,28 +82,27 @@ def simulate(
     path = resolve_scenario(scenario)
     if out is not None and Path(out).exists() and not overwrite:
         raise FileExistsError(errno.EEXIST, "the results folder exists (choose another folder or overwrite it)", os.fspath(out))
+    overrides = dict(overrides) if overrides else None
     if progress is True:
-        raw = _run_with_bar(_core, path)
-    elif callable(progress):
-        raw = _core.run_scenario(os.fspath(path), progress)
+        raw = _run_with_bar(_core, path, overrides)
     else:
-        raw = _core.run_scenario(os.fspath(path), None)
+        raw = _core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides)
     results = Results.from_engine(raw, scenario_path=path)
     if out is not None:
         results.save(out, overwrite=overwrite)
     return results
 
 
-def _run_with_bar(core, path: Path) -> dict:
+def _run_with_bar(core, path: Path, overrides: dict | None) -> dict:
     from tqdm.auto import tqdm
 
-    info = core.load_scenario(os.fspath(path))
+    info = core.load_scenario(os.fspath(path), overrides)
     duration = float(info["duration_s"])
     with tqdm(total=duration, desc=info["name"], unit="s", unit_scale=False, bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]") as bar:
 
         def update(t: float, _duration: float) -> None:
             bar.update(min(t, duration) - bar.n)
 
-        raw = core.run_scenario(os.fspath(path), update)
+        raw = core.run_scenario(os.fspath(path), update, overrides)
         bar.update(duration - bar.n)  # the last instant is duration up to rounding
     return raw

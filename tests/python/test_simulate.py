@@ -342,3 +342,26 @@ def test_cli_scenarios():
     for name in SHIPPED:
         assert name in result.output
     assert "(default)" in result.output
+
+
+def test_overrides_change_the_run_and_are_recorded(sine_file: Path):
+    base = hexadyn.simulate(sine_file, progress=False)
+    changed = hexadyn.simulate(sine_file, progress=False, overrides={"model.friction": "none", "scenario.name": "sine_without_friction"})
+    assert changed.summary["friction"] == "none" and base.summary["friction"] != "none"
+    assert changed.metadata["scenario_name"] == "sine_without_friction"
+    assert 'friction = "none"' in changed.metadata["scenario"] and "with overrides" in changed.metadata["scenario"]
+    # Less friction, less electrical energy for the same motion.
+    assert changed.summary["energy_electrical_j"] < 0.8 * base.summary["energy_electrical_j"]
+    with pytest.raises(ValueError, match=r"model\.frction.*unknown field"):
+        hexadyn.simulate(sine_file, progress=False, overrides={"model.frction": "none"})
+    with pytest.raises(TypeError, match="model.friction"):
+        hexadyn.simulate(sine_file, progress=False, overrides={"model.friction": object()})
+
+
+def test_summary_only_runs_match_full_runs(sine_file: Path):
+    full = _core.run_scenario(str(sine_file), None, {"model.friction": "dry_viscous"})
+    lean = _core.run_scenario(str(sine_file), None, {"model.friction": "dry_viscous"}, False)
+    assert lean["columns"] == {} and len(full["columns"]) > 100
+    for key, value in full["summary"].items():
+        if key != "wall_time_s":
+            assert lean["summary"][key] == value, key

@@ -4,11 +4,11 @@
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use hexadyn::robot::scenario::{run_scenario_until, Scenario, ScenarioError, SummaryValue};
+use hexadyn::robot::scenario::{run_scenario_until, Override, Scenario, ScenarioError, SummaryValue};
 use numpy::PyArray1;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 /// Scenario errors are user errors: one line naming the file, the field, the value and what is
 /// allowed.
@@ -16,18 +16,60 @@ fn value_error(e: ScenarioError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-fn load(path: &PathBuf) -> PyResult<Scenario> {
-    Scenario::from_file(path).map_err(value_error)
+fn load(path: &PathBuf, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Scenario> {
+    let overrides = match overrides {
+        Some(d) => d.iter().map(|(k, v)| {
+            let field: String = k.extract().map_err(|_| PyTypeError::new_err(format!("override names are dotted field strings, not {k:?}")))?;
+            let value = toml_value(&field, &v)?;
+            Ok(Override { field, value })
+        }).collect::<PyResult<Vec<_>>>()?,
+        None => Vec::new(),
+    };
+    Scenario::from_file_with(path, &overrides).map_err(value_error)
+}
+
+/// A Python value as a TOML value: bool, int, float, str, and lists/tuples or dicts of those.
+fn toml_value(field: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(v.extract()?));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        return v.try_iter()?.map(|item| toml_value(field, &item?)).collect::<PyResult<Vec<_>>>().map(toml::Value::Array);
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, item) in d.iter() {
+            let key: String = k.extract()?;
+            table.insert(key.clone(), toml_value(&format!("{field}.{key}"), &item)?);
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    // numpy scalars and other numbers convert through float.
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    Err(PyTypeError::new_err(format!("override {field}: cannot write a {} into a scenario (allowed: bool, int, float, str, lists and dicts of those)", v.get_type().name()?)))
 }
 
 /// Reads and validates a scenario file without running it. Returns a dict with "name",
 /// "description", "duration_s", "friction", "control", "robot" (`"amru5"` or the robot file),
 /// "lifted_legs", "motions" (their count) and "gait" (None, or in gait mode a dict with
 /// "pattern", "period_s", "duty_factor", "cycle", "heading", "navigation", "clearance_m",
-/// "body_height_m" and "changes", their count). Raises ValueError on an invalid scenario.
+/// "body_height_m" and "changes", their count). `overrides` maps dotted scenario fields to
+/// values (`{"model.friction": "dry_viscous"}`). Raises ValueError on an invalid scenario.
 #[pyfunction]
-pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
-    let s = load(&path)?;
+#[pyo3(signature = (path, overrides = None))]
+pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf, overrides: Option<Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
+    let s = load(&path, overrides.as_ref())?;
     let d = PyDict::new(py);
     d.set_item("name", &s.name)?;
     d.set_item("description", &s.description)?;
@@ -63,7 +105,10 @@ pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py,
 /// "columns" (name -> numpy array, one value per control instant, "t" first), "units"
 /// (name -> unit), "descriptions" (name -> one line), "summary" (totals and diagnostics),
 /// "scenario" (the scenario TOML text), "robot" (the robot description TOML text),
-/// "robot_source" (`"amru5"` or the robot file).
+/// "robot_source" (`"amru5"` or the robot file). `overrides` maps dotted scenario fields to
+/// values (see `load_scenario`); the returned "scenario" text is then the effective one. With
+/// `timeseries=False` the "columns", "units" and "descriptions" dicts are empty (campaigns that
+/// only need the summary).
 ///
 /// The simulation runs without the GIL. About every 1 % of the simulated duration (and at the
 /// start and the end) the GIL is taken back to check for signals (Ctrl-C raises
@@ -71,9 +116,9 @@ pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py,
 /// `progress` stops the run and propagates. Raises ValueError with a one-line message for an
 /// invalid scenario or a failed simulation.
 #[pyfunction]
-#[pyo3(signature = (path, progress = None))]
-pub fn run_scenario<'py>(py: Python<'py>, path: PathBuf, progress: Option<Py<PyAny>>) -> PyResult<Bound<'py, PyDict>> {
-    let scenario = load(&path)?;
+#[pyo3(signature = (path, progress = None, overrides = None, timeseries = true))]
+pub fn run_scenario<'py>(py: Python<'py>, path: PathBuf, progress: Option<Py<PyAny>>, overrides: Option<Bound<'py, PyDict>>, timeseries: bool) -> PyResult<Bound<'py, PyDict>> {
+    let scenario = load(&path, overrides.as_ref())?;
     let duration = scenario.duration;
     let step = duration / 100.0;
     let mut next_report = 0.0;
@@ -109,7 +154,7 @@ pub fn run_scenario<'py>(py: Python<'py>, path: PathBuf, progress: Option<Py<PyA
     let columns = PyDict::new(py);
     let units = PyDict::new(py);
     let descriptions = PyDict::new(py);
-    for c in results.series.columns {
+    for c in results.series.columns.into_iter().filter(|_| timeseries) {
         units.set_item(&c.name, c.unit)?;
         descriptions.set_item(&c.name, &c.description)?;
         columns.set_item(&c.name, PyArray1::from_vec(py, c.values))?;

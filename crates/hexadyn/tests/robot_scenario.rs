@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::robot::scenario::{run_scenario, run_scenario_until, ControlMode, HeadingSpec, Scenario, ScenarioError};
+use hexadyn::robot::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Scenario, ScenarioError};
 use hexadyn::robot::{Joint, AMRU5_TOML};
 
 fn scenarios_dir() -> PathBuf {
@@ -581,4 +581,91 @@ fn gait_changes_are_scheduled() {
     assert!(t[switch] > 5.5 && t[switch] < 6.5, "switched at {}", t[switch]);
     let g = r.summary.gait.unwrap();
     assert_eq!((g.gait_switches, g.min_feet_on_ground), (1, 3));
+}
+
+/// The validation scenario under overrides, as the friction comparison and the Monte Carlo
+/// campaigns run it.
+fn overridden(overrides: &[Override]) -> Result<Scenario, ScenarioError> {
+    Scenario::from_file_with(scenarios_dir().join("validation_tripod_1_5cm.toml"), overrides)
+}
+
+#[test]
+fn overrides_set_fields_and_joint_friction_for_every_leg() {
+    let s = overridden(&[
+        Override::new("model.friction", "dry_viscous"),
+        Override::new("model.load_dependence", true),
+        Override::new("gait.heading.vx_m_s", 0.01),
+        Override::new("model.joint_friction.q_r.tau_f_d_plus", 8.04),
+        Override::new("model.joint_friction.q_r.f_v_minus", 16.17),
+        Override::new("model.joint_friction.q_h.f_v_plus", 0.0),
+        Override::new("model.joint_friction.q_h.a_2_plus", 5.5),
+        Override::new("model.joint_friction.q_h.a_1_minus", -2.0),
+    ])
+    .unwrap();
+    assert_eq!(s.model.friction, FrictionModel::DryViscous);
+    assert!(s.model.load_dependence);
+    match &s.gait.as_ref().unwrap().heading {
+        HeadingSpec::Constant(h) => assert_eq!(h.velocity.x, 0.01),
+        other => panic!("constant heading expected, got {other:?}"),
+    }
+    let unchanged = Scenario::from_file(scenarios_dir().join("validation_tripod_1_5cm.toml")).unwrap();
+    for leg in 0..6 {
+        let (f, g) = (s.robot.friction(leg, Joint::Rotation), unchanged.robot.friction(leg, Joint::Rotation));
+        assert_eq!((f.tau_f_d_plus, f.f_v_minus), (8.04, 16.17));
+        assert_eq!((f.tau_f_d_minus, f.f_v_plus), (g.tau_f_d_minus, g.f_v_plus), "keys left out keep the per-leg values");
+        let h = s.robot.friction(leg, Joint::Horizontal);
+        let a = h.load_dependence.unwrap();
+        assert_eq!((h.f_v_plus, a.a_2_plus, a.a_1_minus), (0.0, 5.5, -2.0));
+        assert_eq!(a.a_2_minus, unchanged.robot.friction(leg, Joint::Horizontal).load_dependence.unwrap().a_2_minus);
+    }
+    // The effective text is kept (results folders hold what ran) and reads back the same.
+    assert!(s.text.contains("vx_m_s = 0.01") && s.text.starts_with('#'), "{}", s.text);
+    let again = Scenario::from_str(&s.text, "effective.toml", &scenarios_dir()).unwrap();
+    assert_eq!(again.robot.friction(3, Joint::Horizontal), s.robot.friction(3, Joint::Horizontal));
+}
+
+#[test]
+fn override_errors_name_the_override() {
+    let error = |o: Override| overridden(&[o]).expect_err("must be rejected").to_string();
+    let s = error(Override::new("model.frction", "dry_viscous"));
+    assert!(s.contains("(with overrides)") && s.contains("model.frction") && s.contains("unknown field") && s.contains("friction"), "{s}");
+    assert!(s.contains("(with overrides): field"), "no line of the effective text: {s}");
+    let s = error(Override::new("model.friction", "coulomb"));
+    assert!(s.contains("set by the override model.friction"), "{s}");
+    let s = error(Override::new("scenario.name.x", 1));
+    assert!(s.contains("scenario.name is not a table"), "{s}");
+    let s = error(Override::new("model..friction", 1));
+    assert!(s.contains("not a field path"), "{s}");
+    let s = error(Override::new("model.joint_friction.q_r.a_2_plus", 1.0));
+    assert!(s.contains("only in [model.joint_friction.q_h]"), "{s}");
+    for (field, value) in [("q_h.tau_f_d_plus", -1.0), ("q_v.tau_f_d_minus", 1.0), ("q_r.f_v_plus", -0.5), ("q_h.a_2_minus", 0.3), ("q_h.a_1_plus", -1.0)] {
+        let s = error(Override::new(format!("model.joint_friction.{field}"), value));
+        assert!(s.contains(&format!("model.joint_friction.{field}")) && s.contains("out of range"), "{s}");
+    }
+}
+
+/// Eq. 6.6-6.7 in the summary: the electrical energy per joint type adds up, the averaged power
+/// is E / T, and friction raises the specific resistance of the same walk (a walk without joint
+/// friction still pays Joule losses and the work of the feet).
+#[test]
+fn summary_gives_the_specific_resistance() {
+    let run = |friction: &str| {
+        let s = overridden(&[Override::new("model.friction", friction), Override::new("scenario.duration_s", 12.0)]).unwrap();
+        run_scenario(&s, |_| {}).unwrap().summary
+    };
+    let (none, dry) = (run("none"), run("dry_viscous"));
+    for s in [&none, &dry] {
+        assert!((s.energy_electrical_by_joint_j.iter().sum::<f64>() - s.energy_electrical_j).abs() < 1e-9 * s.energy_electrical_j.abs());
+        assert!((s.average_power_w * s.duration_s - s.energy_electrical_j).abs() < 1e-9 * s.energy_electrical_j.abs());
+        assert!((s.robot_mass_kg - 34.447).abs() < 1e-9);
+    }
+    let xi = |s: &hexadyn::robot::scenario::Summary| {
+        let g = s.gait.as_ref().unwrap();
+        let xi = specific_resistance(s.energy_electrical_j, s.robot_mass_kg, g.distance_walked_m);
+        assert!((g.distance_walked_m - 0.18).abs() < 0.005, "one step of 12 s at 1.5 cm/s: {}", g.distance_walked_m);
+        xi
+    };
+    let (xi_none, xi_dry) = (xi(&none), xi(&dry));
+    assert!(xi_none > 0.0 && xi_dry > 2.0 * xi_none, "xi without friction {xi_none}, dry/viscous {xi_dry}");
+    assert!(dry.energy_friction_j > 0.6 * dry.energy_electrical_j, "friction dominates (Section 6.4): {} of {} J", dry.energy_friction_j, dry.energy_electrical_j);
 }

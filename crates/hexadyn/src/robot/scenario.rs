@@ -23,6 +23,9 @@
 //! d_gnd = 5.0e4                    #   K_gnd N/m^p_K, D_gnd N s/m^(p_D+1), mu (1),
 //! mu = 0.3
 //! supply_voltage_v = 12.0          #   and of the H-bridge supply (V)
+//! [model.joint_friction.q_h]       # optional: friction identical for every leg (Section 6.5),
+//! tau_f_d_plus = 328.5             #   replacing Tables 5.3/5.5 key by key; see the private
+//! a_2_plus = 5.5                   #   submodule joint_friction for the keys and signs
 //!
 //! [integrator]                     # optional table
 //! tolerance = 1.0                  # error estimate of Eq. 3.15 in units of the layout scales
@@ -57,6 +60,10 @@
 //! (`src/robot/scenario/gait.rs`), summarized in docs/architecture.md. Every support stroke
 //! |v_C| (β + 4Δφ) T must fit the workspace diameter. The legs start at their workspace centres
 //! at the body height.
+//!
+//! [`Scenario::from_file_with`] sets fields from outside the file by dotted name
+//! ([`Override`], e.g. `gait.heading.vx_m_s = 0.01`): the friction comparison and the Monte
+//! Carlo campaigns run one file under many overrides.
 //!
 //! Motion values are SI joint units: rad, rad/s for q_r; m, m/s for q_v and q_h. The reference
 //! is the initial joint position (the base) plus the motion ([`JointMotion`]); it must stay
@@ -117,6 +124,9 @@ use super::simulation::{run_until, PlantOptions, SimulatedRobot};
 use super::{Joint, RobotDescription};
 
 mod gait;
+mod joint_friction;
+mod overrides;
+pub use overrides::Override;
 pub use gait::{phase_code, GaitChange, GaitScenario, GaitSummary, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 use crate::control::{joint_pis, Command, Controller, JointMotion, JointPiController, JointReferences, Measurements, Unpowered, JOINTS};
 use crate::physics::FlatGround;
@@ -231,6 +241,8 @@ struct RawModel {
     d_gnd: Option<f64>,
     mu: Option<f64>,
     supply_voltage_v: Option<f64>,
+    #[serde(default)]
+    joint_friction: joint_friction::RawJointFriction,
 }
 
 fn default_friction() -> FrictionModel {
@@ -239,7 +251,7 @@ fn default_friction() -> FrictionModel {
 
 impl Default for RawModel {
     fn default() -> Self {
-        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None }
+        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None, joint_friction: Default::default() }
     }
 }
 
@@ -425,6 +437,20 @@ impl Scenario {
         Self::from_str(&text, &file, &dir)
     }
 
+    /// [`Scenario::from_file`] with some fields set from outside the file ([`Override`]); the
+    /// scenario's `text` is then the effective one.
+    pub fn from_file_with(path: impl AsRef<Path>, overrides: &[Override]) -> Result<Scenario> {
+        if overrides.is_empty() {
+            return Self::from_file(path);
+        }
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io { file: file.clone(), reason: e.to_string() })?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let effective = overrides::apply(&text, &file, overrides)?;
+        Self::from_str(&effective, &format!("{file} (with overrides)"), &dir).map_err(|e| overrides::locate(e, overrides))
+    }
+
     /// Parses and validates a scenario; `origin` names it in errors, `dir` is the folder a
     /// relative `robot` path is taken from.
     #[allow(clippy::should_implement_trait)]
@@ -449,7 +475,7 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
     }
 
     // The robot first: the strokes and the control period bound the other fields.
-    let (robot, robot_source, robot_text) = if h.robot == DEFAULT_ROBOT {
+    let (mut robot, robot_source, robot_text) = if h.robot == DEFAULT_ROBOT {
         (RobotDescription::amru5(), DEFAULT_ROBOT.to_string(), AMRU5_TOML.to_string())
     } else {
         let path: PathBuf = if Path::new(&h.robot).is_absolute() { PathBuf::from(&h.robot) } else { dir.join(&h.robot) };
@@ -470,6 +496,7 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
 
     // Model.
     let m = &raw.model;
+    m.joint_friction.apply(c, &mut robot).map_err(e)?;
     let mut model = ModelOptions::from_description(&robot, m.friction);
     if m.load_dependence && m.friction == FrictionModel::None {
         return Err(e(c.err("model.load_dependence", "true", "needs joint friction", "false with friction = \"none\" (or friction = \"dry_viscous\" or \"lugre\")")));
@@ -741,7 +768,14 @@ pub struct Summary {
     pub body_height_change_m: f64,
     /// Horizontal displacement of the body centre over the run.
     pub body_horizontal_drift_m: f64,
+    /// Mass of the robot m of Eq. 6.6 (kg).
+    pub robot_mass_kg: f64,
+    /// Electrical energy E = sum of u i dt over the actuators (Eq. 6.7).
     pub energy_electrical_j: f64,
+    /// The same per joint type (q_r, q_v, q_h), summed over the legs.
+    pub energy_electrical_by_joint_j: [f64; 3],
+    /// E over the simulated time: the averaged power of the robot (W).
+    pub average_power_w: f64,
     pub energy_joule_j: f64,
     pub energy_friction_j: f64,
     pub energy_motor_work_j: f64,
@@ -787,7 +821,12 @@ impl Summary {
             ("initial_body_height_m", Number(self.initial_body_height_m)),
             ("body_height_change_m", Number(self.body_height_change_m)),
             ("body_horizontal_drift_m", Number(self.body_horizontal_drift_m)),
+            ("robot_mass_kg", Number(self.robot_mass_kg)),
             ("energy_electrical_j", Number(self.energy_electrical_j)),
+            ("energy_electrical_q_r_j", Number(self.energy_electrical_by_joint_j[0])),
+            ("energy_electrical_q_v_j", Number(self.energy_electrical_by_joint_j[1])),
+            ("energy_electrical_q_h_j", Number(self.energy_electrical_by_joint_j[2])),
+            ("average_power_w", Number(self.average_power_w)),
             ("energy_joule_j", Number(self.energy_joule_j)),
             ("energy_friction_j", Number(self.energy_friction_j)),
             ("energy_motor_work_j", Number(self.energy_motor_work_j)),
@@ -816,6 +855,7 @@ impl Summary {
             v.push(("tracking_error_yaw_max_rad", Number(g.tracking_error_yaw_max_rad)));
             v.push(("distance_walked_m", Number(g.distance_walked_m)));
             v.push(("reference_distance_m", Number(g.reference_distance_m)));
+            v.push(("specific_resistance", Number(specific_resistance(self.energy_electrical_j, self.robot_mass_kg, g.distance_walked_m))));
             v.push(("clamped_ik_references", Count(g.clamped_ik_references)));
             v.push(("gait_switches", Count(g.gait_switches)));
             v.push(("min_feet_on_ground", Count(g.min_feet_on_ground)));
@@ -914,6 +954,15 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     Ok(ScenarioResults { series, summary })
 }
 
+/// Specific resistance xi = E / (m g l) (Eq. 6.6), g = 9.81 m/s^2; NaN when nothing was walked.
+pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 {
+    if distance_m > 0.0 {
+        energy_j / (mass_kg * crate::physics::LOAD_GRAVITY * distance_m)
+    } else {
+        f64::NAN
+    }
+}
+
 #[derive(Default)]
 struct RunStats {
     commands: u64,
@@ -980,7 +1029,10 @@ fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &
         initial_body_height_m: q0[2],
         body_height_change_m: q[2] - q0[2],
         body_horizontal_drift_m: (q[0] - q0[0]).hypot(q[1] - q0[1]),
+        robot_mass_kg: plant.robot.model.mechanics.model.total_mass(),
         energy_electrical_j: sum(&e.electrical),
+        energy_electrical_by_joint_j: std::array::from_fn(|j| e.electrical.iter().skip(j).step_by(3).sum()),
+        average_power_w: if plant.state().t > 0.0 { sum(&e.electrical) / plant.state().t } else { 0.0 },
         energy_joule_j: sum(&e.joule),
         energy_friction_j: sum(&e.friction_work),
         energy_motor_work_j: sum(&e.motor_work),
