@@ -279,20 +279,21 @@ def specific_resistance_fit(alpha_w: float, beta_n: float, mass_kg: float, veloc
 
 
 def energy_figures(results: Results) -> dict[str, float]:
-    """Key figures of the power analysis, added to the summary (summary.json).
+    """Key figures of the power analysis, for the summary (summary.json).
 
     ``average_power_w`` (total electrical energy over the duration), ``energy_mechanical_j``
     (Σ of the breakdown's mechanical work), ``friction_share`` (friction work over the
-    electrical energy, Σ E_fric / Σ E_el), ``joule_share``, ``robot_mass_kg`` (the m used) and,
-    when the robot walked, ``specific_resistance`` ξ of Eq. 6.6 with E = Σ E_el (Eq. 6.7) and
-    l = ``distance_walked_m``.
+    electrical energy, Σ E_fric / Σ E_el), ``joule_share``, ``robot_mass_kg`` (the m used, see
+    :func:`robot_mass`) and, when the robot walked, ``specific_resistance`` ξ of Eq. 6.6 with
+    E = Σ E_el (Eq. 6.7) and l = ``distance_walked_m``. :meth:`Results.from_engine` adds those
+    the engine's summary does not already hold.
     """
     b = energy_breakdown(results)
     e_el = float(b["electrical_j"].sum())
     duration = float(results.timeseries.index[-1] - results.timeseries.index[0])
     mass = robot_mass(results)
     figures = {
-        "average_power_w": e_el / duration if duration > 0 else math.nan,
+        "average_power_w": e_el / duration,
         "energy_mechanical_j": float(b["mechanical_j"].sum()),
         "friction_share": float(b["friction_j"].sum()) / e_el if e_el else math.nan,
         "joule_share": float(b["joule_j"].sum()) / e_el if e_el else math.nan,

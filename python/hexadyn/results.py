@@ -102,7 +102,8 @@ class Results:
             "descriptions": descriptions,
         }
         results = cls(frame, units, summary, metadata)
-        results.summary.update(energy.energy_figures(results))
+        for key, value in energy.energy_figures(results).items():
+            results.summary.setdefault(key, value)  # the engine's own figures win
         return results
 
     # -----------------------------------------------------------------------------------------

@@ -112,16 +112,20 @@ def test_specific_resistance_by_hand(walk: Results):
         energy.specific_resistance(1.0, 10.0, 0.0)
     with pytest.raises(ValueError, match="mass = -1"):
         energy.specific_resistance(1.0, -1.0, 1.0)
-    # The run's ξ: E = total electrical energy, m = inertia.total_mass_kg of the robot (34 kg)
-    # until the engine reports robot_mass_kg, l = the distance walked.
+    # The run's ξ: E = total electrical energy, m = the robot mass the engine reports (or
+    # inertia.total_mass_kg of the robot description, 34 kg, for results without it), l = the
+    # distance walked.
     s = walk.summary
-    assert energy.robot_mass(walk) == 34.0
-    assert s["robot_mass_kg"] == 34.0
+    mass = s["robot_mass_kg"]
+    assert mass == pytest.approx(34.447, rel=1e-3), "m_0 + 6 m_leg (robots/amru5.toml)"
+    assert energy.robot_mass(walk) == mass
     assert s["distance_walked_m"] == pytest.approx(0.015 * 24, rel=0.01)
-    assert s["specific_resistance"] == pytest.approx(s["energy_electrical_j"] / (34.0 * 9.81 * s["distance_walked_m"]), rel=1e-12)
-    heavier = Results(walk.timeseries, walk.units, {**walk.summary, "robot_mass_kg": 40.0}, walk.metadata)
-    assert energy.robot_mass(heavier) == 40.0
-    broken = Results(walk.timeseries, walk.units, {k: v for k, v in walk.summary.items() if k != "robot_mass_kg"}, {**walk.metadata, "robot": "[inertia]\n"})
+    assert s["specific_resistance"] == pytest.approx(s["energy_electrical_j"] / (mass * 9.81 * s["distance_walked_m"]), rel=1e-12)
+    assert energy.energy_figures(walk)["specific_resistance"] == pytest.approx(s["specific_resistance"], rel=1e-12)
+    older = Results(walk.timeseries, walk.units, {k: v for k, v in s.items() if k != "robot_mass_kg"}, walk.metadata)
+    assert energy.robot_mass(older) == 34.0
+    assert energy.energy_figures(older)["specific_resistance"] == pytest.approx(s["specific_resistance"] * mass / 34.0, rel=1e-12)
+    broken = Results(walk.timeseries, walk.units, older.summary, {**walk.metadata, "robot": "[inertia]\n"})
     with pytest.raises(ValueError, match="total_mass_kg"):
         energy.robot_mass(broken)
 
