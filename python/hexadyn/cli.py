@@ -174,6 +174,60 @@ def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
 
 
+def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str) -> tuple[float, ...]:
+    try:
+        cm_s = [float(v) for v in value.split(",")]
+    except ValueError:
+        raise click.BadParameter(f"{value!r}; allowed: comma-separated velocities in cm/s, e.g. 1,1.5,2,2.5") from None
+    return tuple(v / 100 for v in cm_s)
+
+
+@cli.command("compare-friction")
+@click.argument("scenario", required=False, default=None)
+@click.option("--velocities", default="1,1.5,2,2.5", show_default=True, callback=_parse_velocities, help="Forward velocities V_x in cm/s (Table 6.2, Fig. 6.19), comma-separated.")
+@click.option("--models", default=None, help="Friction models, comma-separated (default: all four: none, dry_viscous, lugre, dry_viscous_load).")
+@click.option("-o", "--out", type=click.Path(file_okay=False, path_type=Path), default=None, help="Output folder (default: results/compare_friction_<scenario name>, numbered if it exists).")
+@click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=None, help="Worker processes (default: one per CPU).")
+@click.option("--no-progress", is_flag=True, help="No progress bar.")
+@click.option("--formats", default="png", show_default=True, callback=_parse_formats, help="Figure file formats: png (300 dpi), pdf, svg, comma-separated.")
+def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, out: Path | None, overwrite: bool, jobs: int | None, no_progress: bool, formats: tuple[str, ...]) -> None:
+    """Run the validation walk with each friction model at several velocities (Section 6.4).
+
+    SCENARIO (default: the validation case of Table 6.2) is run without friction, with the
+    dry/viscous model, with LuGre, and with the dry/viscous model plus the load dependence of the
+    horizontal joints, at each velocity, in parallel. Writes the averaged power per actuator and
+    model (Tables 6.3-6.6), the robot power and specific resistance versus velocity with the fit
+    P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots.
+    """
+    from hexadyn import compare, energy
+
+    path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
+    if out is None:
+        out = _free_folder(RESULTS_ROOT / f"compare_friction_{path.stem}")
+    elif out.exists() and not overwrite:
+        raise click.ClickException(f"{out}: the output folder exists; use --overwrite or another --out")
+    names = list(compare.MODELS) if models is None else [m.strip() for m in models.split(",") if m.strip()]
+    result = compare.compare_friction(path, velocities, models=names, jobs=jobs, progress=not no_progress)
+    compare.save(result, out, overwrite=overwrite, formats=formats)
+    click.echo(f"Friction comparison: {out}")
+    fmt = lambda v: f"{v:7.3f}"  # noqa: E731
+    for joint, table in compare.joint_tables(result).items():
+        click.echo(f"  averaged power of the {joint} actuators (W), V_x = {result.table_velocity * 100:g} cm/s:")
+        table = table.rename(index=lambda leg: f"leg {leg}" if leg != energy.TOTAL else leg).rename_axis(index=None)
+        for line in table.to_string(float_format=fmt).splitlines():
+            click.echo(f"    {line}")
+    robot = result.robot.reset_index()
+    robot["V_x_cm_s"] = robot.pop("velocity_m_s") * 100
+    columns = ["V_x_cm_s", "model", "average_power_w", "specific_resistance", "friction_share"] + (["friction_power_share"] if "friction_power_share" in robot else [])
+    click.echo("  robot power and specific resistance (Fig. 6.19); friction_share = friction work / electrical energy, friction_power_share = 1 - P(no friction) / P:")
+    for line in robot[columns].to_string(index=False, float_format=fmt).splitlines():
+        click.echo(f"    {line}")
+    click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
+    for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
+        click.echo(f"    {line}")
+
+
 @cli.command()
 def scenarios() -> None:
     """List the shipped scenarios (run one with `hexadyn simulate NAME`)."""

@@ -25,7 +25,7 @@ Outputs (:func:`compare_friction`, written atomically by :func:`save`):
 from __future__ import annotations
 
 import os
-from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -50,6 +50,9 @@ MODEL_LABELS = {
     "lugre": "LuGre",
     "dry_viscous_load": "dry/viscous + load",
 }
+#: Colour and marker of each model in every figure.
+MODEL_COLOURS = {"none": "#1f4e79", "dry_viscous": "#c0392b", "lugre": "#2e8b57", "dry_viscous_load": "#e67e22"}
+MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_load": "D"}
 #: Velocities V_x of Table 6.2 and Fig. 6.19 (m/s).
 DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
 #: Scenario field of the forward velocity.
@@ -84,14 +87,30 @@ class Comparison:
     table_velocity: float
 
 
+def _overrides(scenario: Path, model: str, velocity: float) -> dict[str, Any]:
+    return {**MODELS[model], VELOCITY_FIELD: velocity, "scenario.name": f"{scenario.stem}_{model}_{velocity * 100:g}cm"}
+
+
+def _validate(scenario: Path, runs: Sequence[tuple[str, float]]) -> None:
+    """Checks the scenario and every run without simulating."""
+    from hexadyn import _core
+
+    gait = _core.load_scenario(os.fspath(scenario))["gait"]
+    if gait is None or gait["heading"] != "constant":
+        raise ValueError(f"{scenario}: the friction comparison needs a walking scenario with a constant heading ([control] mode = \"gait\", [gait.heading] kind = \"constant\")")
+    for model, velocity in runs:
+        try:
+            _core.load_scenario(os.fspath(scenario), _overrides(scenario, model, velocity))
+        except ValueError as exc:
+            raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
+
+
 def _run(scenario: str, model: str, velocity: float) -> dict[str, Any]:
     """One run (in a worker process): its averaged power table and robot figures."""
     import hexadyn
 
-    name = f"{Path(scenario).stem}_{model}_{velocity * 100:g}cm"
-    overrides = {**MODELS[model], VELOCITY_FIELD: velocity, "scenario.name": name}
     try:
-        results = hexadyn.simulate(scenario, progress=False, overrides=overrides)
+        results = hexadyn.simulate(scenario, progress=False, overrides=_overrides(Path(scenario), model, velocity))
     except ValueError as exc:
         raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
     s = results.summary
@@ -140,19 +159,18 @@ def compare_friction(
     if unknown or not models:
         raise ValueError(f"friction models {', '.join(map(str, unknown)) or 'none given'}; allowed: {', '.join(MODELS)}")
     runs = [(m, v) for v in velocities for m in models]
+    _validate(path, runs)  # before any run starts
     workers = max(1, min(jobs or os.cpu_count() or 1, len(runs)))
     outputs = []
     bar = _progress_bar(progress, len(runs))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        pending = {pool.submit(_run, os.fspath(path), m, v) for m, v in runs}
+        futures = [pool.submit(_run, os.fspath(path), m, v) for m, v in runs]
         try:
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_EXCEPTION)
-                for future in done:
-                    outputs.append(future.result())
-                    bar(len(outputs))
+            for future in as_completed(futures):
+                outputs.append(future.result())
+                bar(len(outputs))
         except BaseException:
-            for future in pending:
+            for future in futures:
                 future.cancel()
             raise
         finally:
@@ -228,35 +246,34 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
     v_line = np.linspace(v_all.min() * 0.9, v_all.max() * 1.05, 100)
     out = {}
     with plots.style():
-        for stem, ylabel, value, curve in [
-            ("power_velocity", "averaged robot power [W]", "average_power_w", lambda f, v: f.alpha_w + f.beta_n * v),
-            ("specific_resistance", "specific resistance ξ [-]", "specific_resistance", lambda f, v: energy.specific_resistance_fit(f.alpha_w, f.beta_n, f.mass_kg, v)),
+        for stem, title, ylabel, value, curve in [
+            ("power_velocity", "(a) averaged power, fit P = α + β V (Eq. 6.8)", "averaged robot power [W]", "average_power_w", lambda f, v: f.alpha_w + f.beta_n * v),
+            ("specific_resistance", "(b) specific resistance, fit of Eq. 6.11", "specific resistance ξ [-]", "specific_resistance", lambda f, v: energy.specific_resistance_fit(f.alpha_w, f.beta_n, f.mass_kg, v)),
         ]:
-            fig = Figure(figsize=(4.5, 3.2))
+            fig = Figure(figsize=(5.0, 3.6))
             ax = fig.subplots()
-            for k, m in enumerate(models):
+            for m in models:
                 r = robot.xs(m, level="model")
-                f = fit.loc[m]
-                colour = plots.STYLE["axes.prop_cycle"].by_key()["color"][k]
-                ax.plot(r.index.to_numpy() * 100, r[value], linestyle="none", marker="os^Dv"[k % 5], color=colour, label=MODEL_LABELS[m])
-                ax.plot(v_line * 100, curve(f, v_line), color=colour, linewidth=0.8)
+                ax.plot(r.index.to_numpy() * 100, r[value], linestyle="none", marker=MODEL_MARKERS[m], color=MODEL_COLOURS[m], label=MODEL_LABELS[m])
+                ax.plot(v_line * 100, curve(fit.loc[m], v_line), color=MODEL_COLOURS[m], linewidth=0.8)
             ax.set_xlabel("velocity $V_x$ [cm/s]")
             ax.set_ylabel(ylabel)
             ax.legend(frameon=False)
-            fig.suptitle(f"{comparison.scenario}: {ylabel.split(' [')[0]} (markers: runs, lines: Eq. 6.8/6.11 fit)")
+            fig.suptitle(f"{comparison.scenario}\n{title}")
             out[stem] = fig
         tables = joint_tables(comparison)
         fig = Figure(figsize=(6.3, 6.0))
         axes = fig.subplots(3, 1, sharex=True)
         width = 0.8 / len(models)
-        x = np.arange(len(energy.LEGS) + 1)
+        x = np.arange(len(energy.LEGS))
         for ax, (joint, table) in zip(axes, tables.items()):
             for k, m in enumerate(models):
-                ax.bar(x - 0.4 + width * (k + 0.5), table[m].to_numpy(), width, label=MODEL_LABELS[m])
+                ax.bar(x - 0.4 + width * (k + 0.5), table[m].loc[list(energy.LEGS)].to_numpy(), width, color=MODEL_COLOURS[m], label=f"{MODEL_LABELS[m]} ({table.loc[energy.TOTAL, m]:.3g} W)")
+            ax.set_ylim(top=ax.get_ylim()[1] * 1.4)  # room for the legend
+            ax.legend(loc="upper left", title="model (total)", ncol=2, frameon=False)
             ax.set_ylabel(f"${joint}$ power [W]")
             ax.grid(axis="x", visible=False)
-        axes[-1].set_xticks(x, [f"leg {leg}" for leg in energy.LEGS] + ["total"])
-        axes[0].legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=len(models), frameon=False, borderaxespad=0)
+        axes[-1].set_xticks(x, [f"leg {leg}" for leg in energy.LEGS])
         fig.suptitle(f"{comparison.scenario}: averaged power per actuator, $V_x$ = {comparison.table_velocity * 100:g} cm/s (Tables 6.3-6.6)")
         out["power_by_model"] = fig
     return out

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Sequence
 
+import numpy as np
 import pytest
+from matplotlib.colors import to_rgb
+from matplotlib.image import imread
 
 import hexadyn
 from hexadyn import Results
@@ -30,3 +34,21 @@ def walk_file(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def walk(walk_file: Path) -> Results:
     return hexadyn.simulate(walk_file, progress=False)
+
+
+def assert_drawn(png: Path, colours: Sequence[str] = (), width_in: float = 6.3) -> None:
+    """The PNG is a 300 dpi figure `width_in` wide with a substantial drawn part and several
+    colours, and each of `colours` (data series) covers a visible number of pixels."""
+    image = imread(png)[..., :3]
+    width = image.shape[1]
+    assert width >= width_in * 300 * 0.95, f"{png.name}: {width} px wide, not 300 dpi"
+    pixels = image.reshape(-1, 3)
+    background = np.all(pixels > 0.99, axis=1)
+    assert background.mean() < 0.97, f"{png.name}: {100 * (1 - background.mean()):.1f} % drawn"
+    assert (~background).sum() > 20000, png.name
+    levels = (pixels * 15).round().astype(np.int32)
+    distinct = np.unique(levels[:, 0] * 256 + levels[:, 1] * 16 + levels[:, 2]).size
+    assert distinct >= 8, f"{png.name}: only {distinct} colours"
+    for colour in colours:
+        near = np.all(np.abs(pixels - np.array(to_rgb(colour))) < 0.04, axis=1)
+        assert near.sum() > 500, f"{png.name}: {near.sum()} pixels of {colour}"

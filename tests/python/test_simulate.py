@@ -279,22 +279,22 @@ def test_walking_scenario_errors(tmp_path: Path):
 
 def test_cli_simulate(sine_file: Path, tmp_path: Path):
     out = tmp_path / "cli-out"
-    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--no-progress"], prog_name="hexadyn")
+    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--no-progress", "--no-plots"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
     assert f"Results: {out}" in result.output
     assert "body height" in result.output and "balance error" in result.output
     assert Results.load(out).summary["scenario"] == "leg_sine"
     # An existing --out is refused before running, unless --overwrite.
-    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--no-progress"], prog_name="hexadyn")
+    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--no-progress", "--no-plots"], prog_name="hexadyn")
     assert result.exit_code == 1 and "exists" in result.output and "Traceback" not in result.output
-    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--overwrite", "--no-progress"], prog_name="hexadyn")
+    result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--out", str(out), "--overwrite", "--no-progress", "--no-plots"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
 
 
 def test_cli_default_results_folder(sine_file: Path, tmp_path: Path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for expected in ["results/leg_sine", "results/leg_sine-2"]:
-        result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--no-progress"], prog_name="hexadyn")
+        result = CliRunner().invoke(cli, ["simulate", str(sine_file), "--no-progress", "--no-plots"], prog_name="hexadyn")
         assert result.exit_code == 0, result.output
         assert f"Results: {expected}\n" in result.output
         assert (tmp_path / expected / "summary.json").is_file()
