@@ -35,6 +35,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from hexadyn import energy, plots
+from hexadyn.results import parse_toml, write_csv, write_folder
 
 #: Friction models of the comparison: name -> scenario overrides (Section 6.1 and 6.4.4).
 MODELS: dict[str, dict[str, Any]] = {
@@ -186,7 +187,7 @@ def _check_velocities(velocities: Sequence[float]) -> list[float]:
 
 
 def _scenario_velocity(path: Path) -> float | None:
-    heading = energy._toml(path.read_text(encoding="utf-8"), f"{path}").get("gait", {}).get("heading", {})
+    heading = parse_toml(path.read_text(encoding="utf-8"), str(path)).get("gait", {}).get("heading", {})
     value = heading.get("vx_m_s")
     return float(value) if isinstance(value, (int, float)) else None
 
@@ -281,8 +282,6 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
 
 def save(comparison: Comparison, folder: str | os.PathLike, *, overwrite: bool = False, formats: Sequence[str] = plots.DEFAULT_FORMATS) -> Path:
     """Writes the tables and figures of a comparison into `folder`, atomically."""
-    from hexadyn.results import write_csv, write_folder
-
     target = Path(folder)
     if target.exists() and not overwrite:
         raise FileExistsError(17, "the comparison folder exists (choose another folder or overwrite it)", str(target))

@@ -30,10 +30,12 @@ mechanism (legs and body), ∫ (τ_m - τ_f) q' dt:
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 import pandas as pd
+
+from hexadyn.results import parse_toml
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -177,10 +179,10 @@ def averaged_power(results: Results) -> pd.DataFrame:
 
 def _magnetic_energy_change(results: Results, names: Sequence[str]) -> np.ndarray:
     """Δ(½ L i²) per actuator (J), non-zero only if the scenario models the inductance."""
-    scenario = _toml(results.metadata.get("scenario", ""), "the scenario")
+    scenario = parse_toml(results.metadata.get("scenario", ""), "the scenario stored with these results")
     if not scenario.get("model", {}).get("inductance", False):
         return np.zeros(len(names))
-    robot = _toml(results.metadata.get("robot", ""), "the robot description")
+    robot = parse_toml(results.metadata.get("robot", ""), "the robot description stored with these results")
     try:
         inductance = float(robot["motor"]["inductance_mh"]) * 1e-3
     except (KeyError, TypeError, ValueError) as exc:
@@ -223,7 +225,7 @@ def robot_mass(results: Results) -> float:
     """
     if "robot_mass_kg" in results.summary:
         return float(results.summary["robot_mass_kg"])
-    robot = _toml(results.metadata.get("robot", ""), "the robot description")
+    robot = parse_toml(results.metadata.get("robot", ""), "the robot description stored with these results")
     try:
         mass = float(robot["inertia"]["total_mass_kg"])
     except (KeyError, TypeError, ValueError):
@@ -303,14 +305,3 @@ def energy_figures(results: Results) -> dict[str, float]:
     if distance is not None and distance > 0:
         figures["specific_resistance"] = specific_resistance(e_el, mass, float(distance))
     return figures
-
-
-def _toml(text: str, what: str) -> Mapping[str, Any]:
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        import tomli as tomllib
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{what} stored with these results is not valid TOML: {exc}") from None

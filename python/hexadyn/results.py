@@ -41,7 +41,7 @@ PLOTS_DIR = "plots"
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
 
-__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE", "POWER_FILE", "ENERGY_FILE", "PLOTS_DIR", "write_folder", "write_csv"]
+__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE", "POWER_FILE", "ENERGY_FILE", "PLOTS_DIR", "parse_toml", "write_folder", "write_csv"]
 
 
 class Results:
@@ -269,6 +269,19 @@ def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence
     from hexadyn import plots
 
     plots.save_figures(figures, folder, plots.DEFAULT_FORMATS if formats is None else formats)
+
+
+def parse_toml(text: str, what: str) -> dict[str, Any]:
+    """Parses a TOML text kept with the results (scenario, robot description); `what` names it
+    in the ValueError raised for invalid TOML."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{what} is not valid TOML: {exc}") from None
 
 
 def _make_parents(folder: Path) -> list[Path]:
