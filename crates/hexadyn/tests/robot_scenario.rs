@@ -644,28 +644,33 @@ fn override_errors_name_the_override() {
     }
 }
 
-/// Eq. 6.6-6.7 in the summary: the electrical energy per joint type adds up, the averaged power
-/// is E / T, and friction raises the specific resistance of the same walk (a walk without joint
-/// friction still pays Joule losses and the work of the feet).
+/// One step of the validation walk (Section 6.3) with each friction model of the comparison of
+/// Section 6.4: the energy account closes within 1 % (electrical = Joule + friction + contact +
+/// Δ(T + V) + Δ stored), the summary's Eq. 6.6-6.7 quantities add up, and friction orders the
+/// specific resistance: none < dry/viscous < dry/viscous with load (Section 6.4.4), with LuGre
+/// close to dry/viscous (Section 6.4.5: "similar energy consumption").
 #[test]
-fn summary_gives_the_specific_resistance() {
-    let run = |friction: &str| {
-        let s = overridden(&[Override::new("model.friction", friction), Override::new("scenario.duration_s", 12.0)]).unwrap();
+fn walking_energy_closes_and_orders_the_friction_models() {
+    let run = |friction: &str, load: bool| {
+        let s = overridden(&[Override::new("model.friction", friction), Override::new("model.load_dependence", load), Override::new("scenario.duration_s", 12.0)]).unwrap();
         run_scenario(&s, |_| {}).unwrap().summary
     };
-    let (none, dry) = (run("none"), run("dry_viscous"));
-    for s in [&none, &dry] {
-        assert!((s.energy_electrical_by_joint_j.iter().sum::<f64>() - s.energy_electrical_j).abs() < 1e-9 * s.energy_electrical_j.abs());
-        assert!((s.average_power_w * s.duration_s - s.energy_electrical_j).abs() < 1e-9 * s.energy_electrical_j.abs());
-        assert!((s.robot_mass_kg - 34.447).abs() < 1e-9);
-    }
     let xi = |s: &hexadyn::robot::scenario::Summary| {
+        let e = s.energy_electrical_j;
+        assert!(s.energy_balance_error_relative.abs() < 0.01 && s.energy_balance_error_j.abs() < 0.01 * e, "{}: imbalance {} J of {e} J", s.friction, s.energy_balance_error_j);
+        assert!((s.energy_electrical_by_joint_j.iter().sum::<f64>() - e).abs() < 1e-9 * e.abs());
+        assert!((s.average_power_w * s.duration_s - e).abs() < 1e-9 * e.abs());
+        assert!((s.robot_mass_kg - 34.447).abs() < 1e-9);
         let g = s.gait.as_ref().unwrap();
-        let xi = specific_resistance(s.energy_electrical_j, s.robot_mass_kg, g.distance_walked_m);
         assert!((g.distance_walked_m - 0.18).abs() < 0.005, "one step of 12 s at 1.5 cm/s: {}", g.distance_walked_m);
-        xi
+        specific_resistance(e, s.robot_mass_kg, g.distance_walked_m)
     };
-    let (xi_none, xi_dry) = (xi(&none), xi(&dry));
+    let none = run("none", false);
+    let dry = run("dry_viscous", false);
+    let (xi_none, xi_dry, xi_load, xi_lugre) = (xi(&none), xi(&dry), xi(&run("dry_viscous", true)), xi(&run("lugre", false)));
+    println!("xi: none {xi_none:.3}, dry/viscous {xi_dry:.3}, dry/viscous + load {xi_load:.3}, LuGre {xi_lugre:.3}");
     assert!(xi_none > 0.0 && xi_dry > 2.0 * xi_none, "xi without friction {xi_none}, dry/viscous {xi_dry}");
+    assert!(xi_load > 1.05 * xi_dry, "the load dependence raises xi: {xi_load} vs {xi_dry}");
+    assert!((xi_lugre / xi_dry - 1.0).abs() < 0.15, "LuGre {xi_lugre} vs dry/viscous {xi_dry}");
     assert!(dry.energy_friction_j > 0.6 * dry.energy_electrical_j, "friction dominates (Section 6.4): {} of {} J", dry.energy_friction_j, dry.energy_electrical_j);
 }
