@@ -17,14 +17,15 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup run test test-rust test-python bench lock clean
+.PHONY: help setup run test test-rust test-python bench bench-montecarlo lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
 	@echo "make test   set everything up, then run the Rust and Python tests"
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
-	@echo "make lock   re-resolve requirements/lock.txt and requirements/ray-lock.txt"
+	@echo "make bench-montecarlo [MC_ARGS=\"--runs 50\"]  time a Monte Carlo campaign on every core (long)"
+	@echo "make lock   re-resolve requirements/lock.txt"
 	@echo "make clean  remove .venv and the Cargo target directory"
 
 setup: $(BUILD_STAMP)
@@ -60,16 +61,17 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin robot
 	$(CARGO) run --release -p hexadyn-benches --bin gait
 
-# Resolve the locks in throw-away venvs (needs PyPI); review the diff before committing.
+# Optional: the full campaign (1000 runs x 4 velocities x 2 variants) takes hours on a laptop.
+bench-montecarlo: setup
+	$(PY) benches/montecarlo.py $(MC_ARGS)
+
+# Resolve the lock in a throw-away venv (needs PyPI); review the diff before committing.
 lock:
 	rm -rf .lock-venv
 	$(PYTHON) -m venv .lock-venv
 	.lock-venv/bin/pip install --quiet maturin -e '.[test]'
 	{ sed -n '/^#/p' requirements/lock.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v '^hexadyn'; } > requirements/lock.txt.new
-	.lock-venv/bin/pip install --quiet -c requirements/lock.txt.new ray
-	{ sed -n '/^#/p' requirements/ray-lock.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v '^hexadyn'; } > requirements/ray-lock.txt.new
 	mv requirements/lock.txt.new requirements/lock.txt
-	mv requirements/ray-lock.txt.new requirements/ray-lock.txt
 	rm -rf .lock-venv
 
 clean:

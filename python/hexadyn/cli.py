@@ -242,6 +242,55 @@ def scenarios() -> None:
         click.echo(f"  {p.stem:<{width}}  {info['duration_s']:>6g} s  {info['description']}{default}")
 
 
+@cli.command()
+@click.argument("scenario", required=False, default=None)
+@click.option("-o", "--out", type=click.Path(path_type=Path), required=True, help="Campaign folder (created, or resumed if it holds the same campaign).")
+@click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
+@click.option("--velocities", default=None, help="Comma-separated forward velocities in m/s (default: 0.01,0.015,0.02,0.025).")
+@click.option("--variants", default=None, help="Comma-separated friction variants (default: dry_viscous,dry_viscous_load).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
+@click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
+@click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
+@click.option("--no-progress", is_flag=True, help="No progress bar.")
+def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_address, no_progress) -> None:
+    """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
+
+    Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm) for every friction
+    variant, velocity and run, with friction drawn per run from the Gaussians of Table 6.7
+    (truncated at 3 sigma, physical signs). Rerunning the same command resumes an interrupted
+    campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf to --out.
+    """
+    from hexadyn.montecarlo import DEFAULT_SCENARIO as CAMPAIGN_SCENARIO
+    from hexadyn.montecarlo import Campaign
+
+    def listed(option: str, text: str | None, convert):
+        if text is None:
+            return None
+        try:
+            return [convert(item) for item in text.split(",")]
+        except ValueError as exc:
+            raise click.BadParameter(f"{text!r}: {exc}", param_hint=option) from exc
+
+    campaign = Campaign.create(
+        scenario or CAMPAIGN_SCENARIO,
+        velocities=listed("--velocities", velocities, float),
+        runs_per_velocity=runs,
+        variants=listed("--variants", variants, str.strip),
+        seed=seed,
+    )
+    try:
+        table = campaign.run(out, workers=workers, ray=ray_address, progress=not no_progress)
+    except KeyboardInterrupt:
+        click.echo(f"Interrupted: the finished runs are kept in {out}; run the same command again to resume.", err=True)
+        raise SystemExit(130) from None
+    shown = table.rename(columns={"velocity_m_s": "V_x (m/s)", "specific_resistance_mean": "xi mean", "specific_resistance_std": "xi sigma", "specific_resistance_minus_3_sigma": "mean-3sigma", "specific_resistance_plus_3_sigma": "mean+3sigma", "average_power_w_mean": "P mean (W)"})
+    click.echo(f"Specific resistance xi = E/(m g l) (Table 6.8), {campaign.scenario_name}, seed {seed}:")
+    click.echo(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+    if table["failed"].any():
+        click.echo(f"{int(table['failed'].sum())} simulations failed (kept as failed in {out}/runs.sqlite, not retried).")
+    click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
+
+
 def _free_folder(base: Path) -> Path:
     """`base`, or `base-2`, `base-3`... whichever does not exist yet."""
     if not base.exists():

@@ -3,6 +3,7 @@
 use pyo3::prelude::*;
 
 mod mbs;
+mod monte_carlo;
 mod scenario;
 
 #[pymodule]
@@ -11,5 +12,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mbs::PyMultibody>()?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
     Ok(())
 }

@@ -1,0 +1,199 @@
+"""A Monte Carlo campaign over the joint friction uncertainty (Section 6.5).
+
+A campaign simulates a walking scenario (default: the validation walk of Table 6.2,
+``validation_tripod_1_5cm``) once for every (variant, velocity, run): the friction is drawn per
+run (:mod:`~hexadyn.montecarlo.sampling`) and set identical for every leg through
+``[model.joint_friction]``; the velocity is the forward heading velocity ``gait.heading.vx_m_s``.
+The two friction variants of Section 6.5 share the draws (common random numbers):
+
+- ``dry_viscous``: dry/viscous friction (Eq. 6.1) on the three joints, the horizontal viscous
+  slope neglected, no load influence;
+- ``dry_viscous_load``: the same with the load influence on the horizontal dry friction
+  (Eq. 5.12), whose coefficients are drawn too.
+
+The defaults (velocities, runs per velocity) come from the ``[monte_carlo]`` table of the
+scenario's robot description: 1000 runs at 1, 1.5, 2 and 2.5 cm/s for the AMRU5.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from contextlib import closing
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence, Union
+
+from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
+from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction
+from hexadyn.montecarlo.storage import CampaignStore, RunKey
+from hexadyn.montecarlo.tables import plot_specific_resistance, specific_resistance_table, write_table
+from hexadyn.runner import resolve_scenario
+
+__all__ = ["DEFAULT_SCENARIO", "VARIANTS", "Campaign", "run_campaign"]
+
+#: Scenario of a campaign without an explicit one: the Table 6.2 validation walk.
+DEFAULT_SCENARIO = "validation_tripod_1_5cm"
+
+#: Friction variants of Section 6.5 -> whether the load influence of Eq. 5.12 is on.
+VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
+
+#: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
+#: (False) or a callable ``progress(finished_runs, total_runs)`` called after each stored run.
+Progress = Union[bool, Callable[[int, int], object]]
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """What a campaign simulates; build it with :meth:`create`, run it with :meth:`run`."""
+
+    scenario: Path
+    scenario_name: str
+    scenario_text: str
+    velocities_m_per_s: tuple[float, ...]
+    runs_per_velocity: int
+    variants: tuple[str, ...]
+    seed: int
+    distributions: FrictionDistributions
+
+    @classmethod
+    def create(
+        cls,
+        scenario: str | os.PathLike = DEFAULT_SCENARIO,
+        *,
+        velocities: Sequence[float] | None = None,
+        runs_per_velocity: int | None = None,
+        variants: Sequence[str] | None = None,
+        seed: int = 0,
+    ) -> Campaign:
+        """Validates a campaign; ``None`` takes the robot's ``[monte_carlo]`` defaults (all
+        variants for ``variants``). Raises ValueError (one line) for bad input."""
+        from hexadyn import _core
+
+        path = resolve_scenario(scenario)
+        info = _core.load_scenario(os.fspath(path))
+        if info["gait"] is None:
+            raise ValueError(f"{path}: a Monte Carlo campaign needs a walking scenario (control.mode = \"gait\"), for the specific resistance")
+        distributions = FrictionDistributions.of_robot(info["robot"])
+        for field in distributions.gaussians:
+            distributions.accepted_interval(field)
+        runs = distributions.runs_per_velocity if runs_per_velocity is None else runs_per_velocity
+        if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
+            raise ValueError(f"runs per velocity = {runs!r}: need an integer >= 1")
+        velocities = tuple(float(v) for v in (distributions.velocities_m_per_s if velocities is None else velocities))
+        if not velocities or not all(math.isfinite(v) and v > 0 for v in velocities):
+            raise ValueError(f"velocities = {list(velocities)}: need one or more finite velocities > 0 (m/s)")
+        variants = tuple(VARIANTS if variants is None else variants)
+        unknown = [v for v in variants if v not in VARIANTS]
+        if unknown or not variants or len(set(variants)) != len(variants):
+            raise ValueError(f"variants = {list(variants)}: need distinct variants among {', '.join(VARIANTS)}")
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ValueError(f"seed = {seed!r}: need an integer >= 0")
+        campaign = cls(path, info["name"], path.read_text(), velocities, runs, variants, seed, distributions)
+        # The overrides must fit the scenario (a constant heading, ...): check one run of each
+        # variant now rather than store every run as failed.
+        for variant in variants:
+            _core.load_scenario(os.fspath(path), campaign.overrides(RunKey(variant, 0, 0)))
+        return campaign
+
+    def keys(self) -> list[RunKey]:
+        """Every run, in the order they are started: run index first, so that a campaign
+        stopped midway holds about as many runs for every velocity and variant."""
+        return [RunKey(variant, vi, ri) for ri in range(self.runs_per_velocity) for vi in range(len(self.velocities_m_per_s)) for variant in self.variants]
+
+    def friction(self, key: RunKey) -> dict[str, float]:
+        """The ``[model.joint_friction]`` fields of a run: the draw of (velocity, run) without
+        the load coefficients for the variant without load influence, and the fixed values."""
+        drawn = draw_friction(self.distributions, self.seed, key.velocity_index, key.run_index)
+        if not VARIANTS[key.variant]:
+            drawn = {k: v for k, v in drawn.items() if k not in self.distributions.load_parameters}
+        return {**drawn, **self.distributions.fixed}
+
+    def overrides(self, key: RunKey) -> dict[str, Any]:
+        """The scenario overrides of a run."""
+        return {
+            "scenario.name": f"{self.scenario_name}-{key.variant}-v{key.velocity_index}-r{key.run_index}",
+            "model.friction": "dry_viscous",
+            "model.load_dependence": VARIANTS[key.variant],
+            "gait.heading.vx_m_s": self.velocities_m_per_s[key.velocity_index],
+            **self.friction(key),
+        }
+
+    def configuration(self) -> dict[str, Any]:
+        """The content of ``campaign.json``: what must match to resume a campaign."""
+        from hexadyn import __version__
+
+        d = self.distributions
+        return {
+            "hexadyn_version": __version__,
+            "scenario": self.scenario_name,
+            "scenario_text": self.scenario_text,
+            "robot": d.robot,
+            "velocities_m_per_s": list(self.velocities_m_per_s),
+            "runs_per_velocity": self.runs_per_velocity,
+            "variants": list(self.variants),
+            "seed": self.seed,
+            "truncation_sigmas": d.truncation_sigmas,
+            "gaussians": d.gaussians,
+            "physical_bounds": d.physical_bounds,
+            "load_parameters": list(d.load_parameters),
+            "fixed": d.fixed,
+        }
+
+    def run(self, out: str | os.PathLike, *, workers: int | None = None, ray: str | None = None, progress: Progress = True):
+        """Runs the campaign into the folder ``out`` (resuming it if it holds this campaign)
+        and returns Table 6.8 (:func:`~hexadyn.montecarlo.tables.specific_resistance_table`),
+        also written there with Fig. 6.20.
+
+        ``workers`` processes on the local cores (default: all), or Ray tasks when ``ray`` is a
+        cluster address (``"local"``: a Ray instance started here with ``workers`` CPUs). On
+        Ctrl-C (KeyboardInterrupt, also raised by ``progress``) the running simulations are
+        stopped and the finished ones are kept: running again resumes.
+        """
+        executor: Executor = Ray(ray, workers) if ray else ProcessPool(workers)
+        keys = self.keys()
+        with CampaignStore.open(out, self.configuration()) as store:
+            finished = store.finished()
+            pending = [k for k in keys if k not in finished]
+            if pending:
+                self._simulate(store, executor, pending, len(keys), progress)
+            table = specific_resistance_table(store.runs(), self.variants)
+        write_table(table, store.folder)
+        plot_specific_resistance(table, store.folder)
+        return table
+
+    def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
+        from tqdm.auto import tqdm
+
+        done = total - len(pending)
+        bar = tqdm(total=total, initial=done, desc=self.scenario_name, unit="run", disable=progress is not True)
+        tasks: Iterable = ((key, self.overrides(key)) for key in pending)
+        try:
+            with closing(executor.run(os.fspath(self.scenario), tasks)) as outcomes:
+                for key, outcome in outcomes:
+                    store.add(key, self.velocities_m_per_s[key.velocity_index], self.friction(key), outcome)
+                    done += 1
+                    bar.update()
+                    if outcome["status"] == "failed":
+                        bar.write(f"failed (stored, not retried): {key.variant}, V_x = {self.velocities_m_per_s[key.velocity_index]} m/s, run {key.run_index}: {outcome['error']}")
+                    if callable(progress):
+                        progress(done, total)
+        finally:
+            bar.close()
+
+
+def run_campaign(
+    out: str | os.PathLike,
+    scenario: str | os.PathLike = DEFAULT_SCENARIO,
+    *,
+    velocities: Sequence[float] | None = None,
+    runs_per_velocity: int | None = None,
+    variants: Sequence[str] | None = None,
+    seed: int = 0,
+    workers: int | None = None,
+    ray: str | None = None,
+    progress: Progress = True,
+):
+    """:meth:`Campaign.create` then :meth:`Campaign.run`: returns Table 6.8 as a DataFrame."""
+    campaign = Campaign.create(scenario, velocities=velocities, runs_per_velocity=runs_per_velocity, variants=variants, seed=seed)
+    return campaign.run(out, workers=workers, ray=ray, progress=progress)

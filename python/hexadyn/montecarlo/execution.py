@@ -1,0 +1,128 @@
+"""Running the simulations of a campaign: on the local cores (a process pool) or on Ray.
+
+Both executors take (key, overrides) tasks and yield (key, outcome) as the simulations finish,
+in any order; the caller (the parent process, or the Ray driver) stores the outcomes. An
+outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
+:data:`~hexadyn.montecarlo.storage.SUMMARY_COLUMNS`) or ``{"status": "failed", "error":
+message}`` for a simulation the engine rejected (ValueError); any other exception stops the
+campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the tasks not
+finished yet and stops the workers.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any, Iterable, Iterator, Mapping, Protocol
+
+from hexadyn.montecarlo.storage import SUMMARY_COLUMNS, RunKey
+
+__all__ = ["Executor", "ProcessPool", "Ray", "simulate_run"]
+
+Task = tuple[RunKey, Mapping[str, Any]]
+
+
+def simulate_run(scenario: str, overrides: Mapping[str, Any]) -> dict[str, Any]:
+    """Runs one simulation (summary only) and returns its outcome."""
+    from hexadyn import _core
+
+    try:
+        summary = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)["summary"]
+    except ValueError as exc:
+        return {"status": "failed", "error": " ".join(str(exc).split())}
+    return {"status": "ok", "summary": {c: summary[c] for c in SUMMARY_COLUMNS}}
+
+
+class Executor(Protocol):
+    """Runs (key, overrides) tasks of a scenario, yielding (key, outcome) as they finish."""
+
+    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]: ...
+
+
+class ProcessPool:
+    """The local cores: a ``concurrent.futures.ProcessPoolExecutor`` of ``workers`` processes
+    (default: every core). The workers ignore SIGINT: Ctrl-C reaches the parent, which stops
+    them; a worker whose parent died (SIGKILL) exits by itself (:func:`_init_worker`)."""
+
+    def __init__(self, workers: int | None = None) -> None:
+        if workers is not None and workers < 1:
+            raise ValueError(f"workers = {workers}: need at least 1 worker")
+        self.workers = workers or os.cpu_count() or 1
+
+    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
+        executor = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker, initargs=(os.getpid(),))
+        try:
+            futures = {executor.submit(simulate_run, scenario, overrides): key for key, overrides in tasks}
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        except BaseException:
+            executor.shutdown(wait=False, cancel_futures=True)
+            _terminate_workers(executor)
+            raise
+        executor.shutdown()
+
+
+def _init_worker(parent: int) -> None:
+    """Ignores SIGINT and exits once the parent process is gone: the workers of a killed
+    campaign would otherwise wait for tasks forever (they hold both ends of the task queue)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    def exit_when_orphaned() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=exit_when_orphaned, name="exit-when-orphaned", daemon=True).start()
+
+
+def _terminate_workers(executor: ProcessPoolExecutor) -> None:
+    """Stops the simulations still running (``terminate_workers`` from Python 3.14; the pool's
+    process table before)."""
+    terminate = getattr(executor, "terminate_workers", None)
+    if terminate is not None:
+        terminate()
+        return
+    for process in list((executor._processes or {}).values()):
+        process.terminate()
+
+
+class Ray:
+    """A Ray cluster (``address``), or a Ray instance started here for ``address = "local"``
+    (with ``workers`` CPUs, default every core). An already initialized Ray (``ray.init`` called
+    by the user) is used as it is and left running."""
+
+    def __init__(self, address: str, workers: int | None = None) -> None:
+        if workers is not None and workers < 1:
+            raise ValueError(f"workers = {workers}: need at least 1 worker")
+        self.address = address
+        self.workers = workers
+
+    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
+        try:
+            import ray
+        except ImportError as exc:
+            raise ValueError("--ray needs Ray: pip install 'hexadyn[ray]'") from exc
+
+        started = not ray.is_initialized()
+        if started:
+            if self.address == "local":
+                ray.init(num_cpus=self.workers, include_dashboard=False, log_to_driver=False)
+            else:
+                ray.init(address=self.address, log_to_driver=False)
+        remote = ray.remote(num_cpus=1)(simulate_run)
+        refs: dict[Any, RunKey] = {}
+        try:
+            refs = {remote.remote(scenario, dict(overrides)): key for key, overrides in tasks}
+            while refs:
+                (done,), _ = ray.wait(list(refs), num_returns=1)
+                yield refs.pop(done), ray.get(done)
+        except BaseException:
+            for ref in refs:
+                ray.cancel(ref, force=True)
+            raise
+        finally:
+            if started:
+                ray.shutdown()

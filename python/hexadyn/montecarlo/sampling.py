@@ -1,0 +1,95 @@
+"""Friction draws of the Monte Carlo runs (Section 6.5, Eq. 6.12, Table 6.7).
+
+Every drawn parameter follows a Gaussian N(mu*, sigma*^2); a value outside mu* +- 3 sigma* or
+with a non-physical sign is rejected and drawn again, so each parameter follows the normal
+distribution truncated to the intersection of both intervals. The distributions come from the
+robot description through ``hexadyn._core.monte_carlo_distributions`` (not computed here).
+
+A run is identified by (velocity index, run index); its random stream is
+``np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(velocity_index, run_index)))``,
+so a draw does not depend on scheduling, worker count or interruptions. Both friction variants
+of a run use the same draw (common random numbers).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["FrictionDistributions", "draw_friction"]
+
+
+@dataclass(frozen=True)
+class FrictionDistributions:
+    """The Monte Carlo set-up of a robot description (its ``[monte_carlo]`` table).
+
+    Attributes:
+        robot: ``"amru5"`` or the robot description file.
+        runs_per_velocity, truncation_sigmas, velocities_m_per_s: the defaults of a campaign and
+            the truncation (+- 3 sigma in the thesis).
+        gaussians: scenario field (``model.joint_friction.q_r.tau_f_d_plus``...) -> (mu, sigma),
+            in the order they are drawn.
+        physical_bounds: scenario field -> (low, high), the physical values.
+        load_parameters: the fields of ``gaussians`` acting only with the load influence
+            (Eq. 5.12 coefficients of q_h).
+        fixed: scenario field -> value of the parameters set but not drawn (the horizontal
+            viscous slopes, neglected in Section 6.5).
+    """
+
+    robot: str
+    runs_per_velocity: int
+    truncation_sigmas: float
+    velocities_m_per_s: tuple[float, ...]
+    gaussians: dict[str, tuple[float, float]]
+    physical_bounds: dict[str, tuple[float, float]]
+    load_parameters: tuple[str, ...]
+    fixed: dict[str, float]
+
+    @classmethod
+    def of_robot(cls, robot: str = "amru5") -> FrictionDistributions:
+        """Reads the distributions of a robot description (``"amru5"`` or a file path)."""
+        from hexadyn import _core
+
+        d = _core.monte_carlo_distributions(robot)
+        return cls(
+            robot=d["robot"],
+            runs_per_velocity=int(d["runs_per_velocity"]),
+            truncation_sigmas=float(d["truncation_sigmas"]),
+            velocities_m_per_s=tuple(float(v) for v in d["velocities_m_per_s"]),
+            gaussians={k: (float(mu), float(sigma)) for k, (mu, sigma) in d["gaussians"].items()},
+            physical_bounds={k: (float(lo), float(hi)) for k, (lo, hi) in d["physical_bounds"].items()},
+            load_parameters=tuple(d["load_parameters"]),
+            fixed={k: float(v) for k, v in d["fixed"].items()},
+        )
+
+    def accepted_interval(self, field: str) -> tuple[float, float]:
+        """The values a draw of ``field`` keeps: mu +- truncation_sigmas sigma, physical ones.
+
+        Raises ValueError when the two intervals do not meet (no draw would ever be kept).
+        """
+        mu, sigma = self.gaussians[field]
+        low, high = self.physical_bounds[field]
+        k = self.truncation_sigmas
+        lo, hi = max(mu - k * sigma, low), min(mu + k * sigma, high)
+        if not lo <= hi:
+            raise ValueError(f"{self.robot}: {field} ~ N({mu}, {sigma}^2) has no physical value within +-{k} sigma")
+        return lo, hi
+
+
+def draw_friction(distributions: FrictionDistributions, seed: int, velocity_index: int, run_index: int) -> dict[str, float]:
+    """The friction parameters of run (velocity_index, run_index), all of ``gaussians``.
+
+    Parameters are drawn one after the other in the order of ``distributions.gaussians``, each
+    redrawn until it lies in its :meth:`~FrictionDistributions.accepted_interval`.
+    """
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(velocity_index, run_index)))
+    drawn = {}
+    for field, (mu, sigma) in distributions.gaussians.items():
+        lo, hi = distributions.accepted_interval(field)
+        x = math.nan
+        while not lo <= x <= hi:
+            x = mu + sigma * float(rng.standard_normal())
+        drawn[field] = x
+    return drawn

@@ -1,0 +1,177 @@
+"""The campaign folder: ``campaign.json`` (the configuration) and ``runs.sqlite`` (the runs).
+
+``campaign.json`` holds the configuration of the campaign (scenario text, velocities, runs,
+variants, seed, distributions) and the hexadyn version; a folder is resumed only with the same
+configuration. ``runs.sqlite`` has one row per finished simulation in the table ``runs``, keyed
+by (variant, velocity_index, run_index), written by the parent process in one transaction per
+run: an interrupted campaign loses at most the runs that were still being simulated, and the
+primary key forbids duplicates. Failed simulations are stored too (status ``failed`` and the
+error message), so a resumed campaign does not retry them.
+
+Output files (tables, plots) are written atomically with :func:`write_atomically`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sqlite3
+import tempfile
+from pathlib import Path
+from typing import Any, Callable, Mapping, NamedTuple
+
+__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey", "write_atomically"]
+
+CAMPAIGN_FILE = "campaign.json"
+DATABASE_FILE = "runs.sqlite"
+#: Identifies a hexadyn Monte Carlo folder in campaign.json.
+FORMAT = "hexadyn-montecarlo"
+
+#: Summary entries of a run kept in the database (``_core.run_scenario(...)["summary"]``):
+#: ξ (Eq. 6.6), E and its split per joint type, distance, mass, averaged power, Joule and
+#: friction losses, the energy balance error, the simulated and the wall time.
+SUMMARY_COLUMNS = (
+    "specific_resistance",
+    "energy_electrical_j",
+    "energy_electrical_q_r_j",
+    "energy_electrical_q_v_j",
+    "energy_electrical_q_h_j",
+    "energy_joule_j",
+    "energy_friction_j",
+    "energy_balance_error_relative",
+    "robot_mass_kg",
+    "distance_walked_m",
+    "average_power_w",
+    "duration_s",
+    "wall_time_s",
+)
+
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS runs (
+    variant TEXT NOT NULL,
+    velocity_index INTEGER NOT NULL,
+    run_index INTEGER NOT NULL,
+    velocity_m_s REAL NOT NULL,
+    status TEXT NOT NULL CHECK (status IN ('ok', 'failed')),
+    error TEXT,
+    parameters TEXT NOT NULL,
+    {", ".join(f"{c} REAL" for c in SUMMARY_COLUMNS)},
+    PRIMARY KEY (variant, velocity_index, run_index)
+)
+"""
+
+
+class RunKey(NamedTuple):
+    """One simulation of a campaign: a friction variant, a velocity (index) and a run index."""
+
+    variant: str
+    velocity_index: int
+    run_index: int
+
+
+class CampaignStore:
+    """A campaign folder, created or reopened with :meth:`open`."""
+
+    def __init__(self, folder: Path, connection: sqlite3.Connection) -> None:
+        self.folder = folder
+        self._db = connection
+
+    @classmethod
+    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any]) -> CampaignStore:
+        """Creates the campaign folder, or reopens it if it holds the same configuration.
+
+        Raises ValueError if ``folder`` holds something else than a campaign, or a campaign
+        with another configuration (naming the first differing field).
+        """
+        folder = Path(folder)
+        config_file = folder / CAMPAIGN_FILE
+        if config_file.is_file():
+            _check_same_configuration(config_file, configuration)
+        elif folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+            raise ValueError(f"{folder}: not a Monte Carlo campaign folder (no {CAMPAIGN_FILE}); choose an empty or new folder")
+        else:
+            folder.mkdir(parents=True, exist_ok=True)
+            text = json.dumps({"format": FORMAT, "configuration": dict(configuration)}, indent=2) + "\n"
+            write_atomically(config_file, lambda tmp: tmp.write_text(text))
+        connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
+        with connection:
+            connection.execute(_SCHEMA)
+        return cls(folder, connection)
+
+    def close(self) -> None:
+        self._db.close()
+
+    def __enter__(self) -> CampaignStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def finished(self) -> set[RunKey]:
+        """The runs stored so far (succeeded or failed)."""
+        rows = self._db.execute("SELECT variant, velocity_index, run_index FROM runs")
+        return {RunKey(*row) for row in rows}
+
+    def add(self, key: RunKey, velocity_m_s: float, parameters: Mapping[str, Any], outcome: Mapping[str, Any]) -> None:
+        """Stores one finished run in its own transaction.
+
+        ``outcome`` is ``{"status": "ok", "summary": {...}}`` or ``{"status": "failed",
+        "error": message}``. A run already stored is an error (sqlite3.IntegrityError).
+        """
+        summary = outcome.get("summary", {})
+        columns = ("variant", "velocity_index", "run_index", "velocity_m_s", "status", "error", "parameters", *SUMMARY_COLUMNS)
+        values = (*key, velocity_m_s, outcome["status"], outcome.get("error"), json.dumps(dict(parameters)), *(summary.get(c) for c in SUMMARY_COLUMNS))
+        with self._db:
+            self._db.execute(f"INSERT INTO runs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})", values)
+
+    def runs(self):
+        """Every stored run as a pandas DataFrame sorted by (variant, velocity_index, run_index)
+        (the order makes aggregates independent of the order the runs finished in)."""
+        import pandas as pd
+
+        return pd.read_sql_query("SELECT * FROM runs ORDER BY variant, velocity_index, run_index", self._db)
+
+
+def _check_same_configuration(config_file: Path, configuration: Mapping[str, Any]) -> None:
+    try:
+        stored = json.loads(config_file.read_text())
+    except ValueError as exc:
+        raise ValueError(f"{config_file}: not a campaign file ({exc})") from exc
+    if not isinstance(stored, dict) or stored.get("format") != FORMAT:
+        raise ValueError(f"{config_file}: not a hexadyn Monte Carlo campaign file")
+    # JSON round trip: tuples become lists, as in the stored file.
+    wanted = json.loads(json.dumps(dict(configuration)))
+    old = stored.get("configuration", {})
+    for field in sorted(set(wanted) | set(old)):
+        if wanted.get(field) != old.get(field):
+            raise ValueError(
+                f"{config_file.parent}: the campaign there has another {field} "
+                f"({_short(old.get(field))} there, {_short(wanted.get(field))} now); "
+                "rerun with its configuration to resume it, or choose another folder"
+            )
+
+
+def _short(value: Any) -> str:
+    text = json.dumps(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
+    """Calls ``write(tmp)`` on a temporary file next to ``path``, then renames it to ``path``:
+    the file appears complete or not at all (a failure removes the temporary file)."""
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        write(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
