@@ -59,6 +59,7 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin engine
 	$(CARGO) run --release -p hexadyn-benches --bin robot
 	$(CARGO) run --release -p hexadyn-benches --bin gait
+	$(CARGO) run --release -p hexadyn-benches --bin walk
 
 # Resolve the locks in throw-away venvs (needs PyPI); review the diff before committing.
 lock:
