@@ -6,6 +6,7 @@
 //! work, against the baseline measured in the same run: the thesis' own figure, 75 s of walking
 //! in 260 s (Table 3.2), scaled to the simulated duration. The physics figures (energy balance,
 //! tracking and walking errors) are printed alongside so that a speed-up that changes them shows.
+//! `walk [case]` runs only the case of that index (0, 1, 2), e.g. under a profiler.
 
 use std::path::Path;
 
@@ -33,7 +34,9 @@ fn main() {
         "{:<38} {:>7} {:>6} {:>9} {:>6} {:>5} {:>7} {:>5} {:>5} {:>9} {:>8} {:>8} {:>9}",
         "case", "wall s", "RTF", "vs thesis", "steps", "rej.", "Newton", "Jac.", "LU", "energy %", "q_r mrad", "q_v mm", "XY err mm"
     );
-    for (name, s) in &cases {
+    let only: Option<usize> = std::env::args().nth(1).map(|a| a.parse().unwrap());
+    for (i, (name, s)) in cases.iter().enumerate() {
+        if only.is_some_and(|o| o != i) { continue; }
         let r = run_scenario(s, |_| {}).expect("simulation");
         let m = &r.summary;
         let wall = m.wall_time_s;
