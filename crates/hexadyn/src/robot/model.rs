@@ -267,7 +267,13 @@ pub struct Outputs {
 #[derive(Clone)]
 pub struct Robot {
     pub model: Arc<RobotModel>,
-    pub data: Data,
+    /// The multibody workspace of the last evaluation (see [`Robot::data`]).
+    data: Data,
+    /// The (q, q') of the multibody coordinates `data` holds the kinematics of: the kinematics
+    /// depend on nothing else, so an evaluation at the same (q, q') and another q'' (the
+    /// consistent accelerations after an input jump, the mass matrix, the outputs of an accepted
+    /// step) reuses them.
+    kinematics_at: Option<([f64; DOF], [f64; DOF])>,
     /// Motor voltages held over the control period (inputs with digital control, V).
     pub voltages: [f64; JOINTS],
     /// Joint references (inputs with continuous PID control, rad or m).
@@ -304,14 +310,28 @@ impl InertialJacobian {
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
-        Robot { model, data, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None }
+        Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None }
+    }
+
+    /// The multibody workspace: kinematics and applied forces of the last evaluation.
+    pub fn data(&self) -> &Data {
+        &self.data
+    }
+
+    /// Kinematics of the multibody coordinates at (q, q') into `data`, unless it holds them.
+    fn kinematics(&mut self, q: &[f64], qd: &[f64]) {
+        let at = (q[..DOF].try_into().expect("DOF coordinates"), qd[..DOF].try_into().expect("DOF coordinates"));
+        if self.kinematics_at != Some(at) {
+            mbs::kinematics(&self.model.mechanics.model, &mut self.data, &q[..DOF], &qd[..DOF]);
+            self.kinematics_at = Some(at);
+        }
     }
 
     /// Multibody rows with the contact and joint forces frozen at `contact` and `joint`
     /// (generalized joint forces), and the foot velocities.
     fn frozen_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], contact: &[Vector3<f64>; 6], joint: &[f64; JOINTS], f: &mut [f64], feet: &mut [Vector3<f64>; 6]) {
+        self.kinematics(q, qd);
         let mech = &self.model.mechanics;
-        mbs::kinematics(&mech.model, &mut self.data, &q[..DOF], &qd[..DOF]);
         self.data.clear_forces();
         for (leg, bodies) in mech.legs.iter().enumerate() {
             let p = self.data.point(bodies.links[3], &mech.foot_local);
@@ -378,9 +398,9 @@ impl Robot {
     /// Kinematics, contact forces and joint torques at (q, q', q''), written into the multibody
     /// workspace and [`Self::outputs`].
     pub fn evaluate(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) {
+        self.kinematics(q, qd);
         let m = &*self.model;
         let mech = &m.mechanics;
-        mbs::kinematics(&mech.model, &mut self.data, &q[..DOF], &qd[..DOF]);
         self.data.clear_forces();
         let out = &mut self.outputs;
         // Ground contact at the feet (Eq. 3.72-3.73).

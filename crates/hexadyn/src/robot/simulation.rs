@@ -75,8 +75,8 @@ impl EnergyAccount {
             p.contact[leg] = c.absorbed_power;
         }
         self.contact_energy = out.contact.iter().map(|c| c.elastic_energy).sum();
-        self.kinetic = mbs::kinetic_energy(&m.mechanics.model, &robot.data);
-        self.potential = mbs::potential_energy(&m.mechanics.model, &robot.data);
+        self.kinetic = mbs::kinetic_energy(&m.mechanics.model, robot.data());
+        self.potential = mbs::potential_energy(&m.mechanics.model, robot.data());
         if let Some(prev) = &self.powers {
             let h = 0.5 * (p.t - prev.t);
             for k in 0..JOINTS {
