@@ -659,6 +659,13 @@ impl LegKinematics {
     pub fn workspace_for_body_height(&self, height: f64, lift: f64) -> Result<Workspace, LegKinematicsError> {
         self.workspace(-height, -height + lift)
     }
+
+    /// True when `other` reaches the same points of its own leg frame: same pantograph, crossing
+    /// C* and joint limits (the legs of AMRU5 differ only by their angle α on the body), so both
+    /// have the same [`Workspace`] at every height.
+    pub fn same_leg_frame_reach(&self, other: &LegKinematics) -> bool {
+        self.pantograph == other.pantograph && self.crossing == other.crossing && self.limits == other.limits
+    }
 }
 
 /// R_z(−q_r) v.
@@ -1078,7 +1085,12 @@ mod tests {
                 w.z_max
             );
         }
+        let mut longer_stroke = legs[0].clone();
+        longer_stroke.limits.upper[1] += 0.01;
+        assert!(!longer_stroke.same_leg_frame_reach(&legs[0]));
         for kin in &legs {
+            // The legs differ only by their place on the body: the scenarios share one search.
+            assert!(kin.same_leg_frame_reach(&legs[0]));
             assert_eq!(kin.workspace(w.z_min, w.z_max).unwrap(), w);
             let bigger = Workspace { radius: w.radius + 1e-4, ..w };
             let mut clamped = 0;

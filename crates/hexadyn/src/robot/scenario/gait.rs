@@ -312,8 +312,14 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
             return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach));
         }
     }
-    let mut workspaces = Vec::with_capacity(6);
-    for leg in &legs {
+    let mut workspaces: Vec<Workspace> = Vec::with_capacity(6);
+    for (l, leg) in legs.iter().enumerate() {
+        // The workspace search is costly (a large share of a short walk's run time): legs that
+        // reach the same points of their leg frames share it.
+        if let Some(m) = (0..l).find(|&m| legs[m].same_leg_frame_reach(leg)) {
+            workspaces.push(workspaces[m]);
+            continue;
+        }
         match leg.workspace_for_body_height(height, clearance) {
             Ok(w) => workspaces.push(w),
             Err(e) => {
