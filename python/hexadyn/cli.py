@@ -174,7 +174,10 @@ def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
 
 
-def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str) -> tuple[float, ...]:
+def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | None) -> tuple[float, ...] | None:
+    """`--velocities` in cm/s (as the thesis quotes them, Table 6.2) -> m/s."""
+    if value is None:
+        return None
     try:
         cm_s = [float(v) for v in value.split(",")]
     except ValueError:
@@ -246,7 +249,7 @@ def scenarios() -> None:
 @click.argument("scenario", required=False, default=None)
 @click.option("-o", "--out", type=click.Path(path_type=Path), required=True, help="Campaign folder (created, or resumed if it holds the same campaign).")
 @click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
-@click.option("--velocities", default=None, help="Comma-separated forward velocities in m/s (default: 0.01,0.015,0.02,0.025).")
+@click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
 @click.option("--variants", default=None, help="Comma-separated friction variants (default: dry_viscous,dry_viscous_load).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
 @click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
@@ -273,7 +276,7 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_add
 
     campaign = Campaign.create(
         scenario or CAMPAIGN_SCENARIO,
-        velocities=listed("--velocities", velocities, float),
+        velocities=None if velocities is None else list(velocities),
         runs_per_velocity=runs,
         variants=listed("--variants", variants, str.strip),
         seed=seed,

@@ -64,7 +64,7 @@ def stored_runs(folder: Path) -> pd.DataFrame:
 
 
 def cli_command(scenario: Path, out: Path) -> list[str]:
-    velocities = ",".join(map(str, VELOCITIES))
+    velocities = ",".join(f"{v * 100:g}" for v in VELOCITIES)  # cm/s on the command line
     return [sys.executable, "-m", "hexadyn.cli", "montecarlo", str(scenario), "--out", str(out), "--runs", str(RUNS), "--velocities", velocities, "--seed", str(SEED), "--workers", "2", "--no-progress"]
 
 
