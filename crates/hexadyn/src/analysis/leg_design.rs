@@ -475,7 +475,9 @@ mod tests {
         assert_relative_eq!(lin.k[(1, 2)], lin.k[(2, 1)], max_relative = 1e-4);
     }
 
-    /// Every leg has the same 3 × 3 model (same construction rotated about z_b).
+    /// Every leg has the same 3 × 3 model (same construction rotated about z_b), to 1e-6 of the
+    /// block's largest entry: the finite differences of the linearization leave rounding noise
+    /// of that order on the entries that vanish (k_00 ~ 3e-6 against k_22 ~ 5e2).
     #[test]
     fn leg_design_same_block_for_every_leg() {
         let description = amru5();
@@ -486,7 +488,8 @@ mod tests {
             for (a, b) in [(&lin.m, &reference.m), (&lin.c, &reference.c), (&lin.k, &reference.k), (&lin.f_elec, &reference.f_elec)] {
                 for i in 0..3 {
                     for j in 0..3 {
-                        assert!((a[(i, j)] - b[(i, j)]).abs() <= 1e-6 * (b[(i, i)].abs() + b[(j, j)].abs()) + 1e-6, "leg {leg} [{i},{j}]: {} vs {}", a[(i, j)], b[(i, j)]);
+                        let scale = b.amax().max(1.0);
+                        assert!((a[(i, j)] - b[(i, j)]).abs() <= 1e-6 * scale, "leg {leg} [{i},{j}]: {} vs {} (largest entry {scale})", a[(i, j)], b[(i, j)]);
                     }
                 }
             }

@@ -19,9 +19,20 @@ pub struct Data {
     /// Convective accelerations J̇_ω q̇ and J̇_S q̇ (Eq. 3.27, 3.34).
     pub(crate) alpha_bias: Vec<Vector3<f64>>,
     pub(crate) accel_bias: Vec<Vector3<f64>>,
-    /// Partial velocities d_ij and δ_ij (Eq. 3.24, 3.31), flat over the bodies' columns.
+    /// Partial velocities d_ij and δ_ij (Eq. 3.24, 3.31), flat over the bodies' columns; filled
+    /// from the relative ones by [`super::partial_velocities`] (`complete` tells when).
     pub(crate) d: Vec<Vector3<f64>>,
     pub(crate) delta: Vec<Vector3<f64>>,
+    pub(crate) complete: bool,
+    /// Partial velocities of each body relative to its reference body, over the body's own
+    /// columns: d_ij = d_pj + δ_pj × (p_i − p_p) + d^rel_ij and δ_ij = δ_pj + δ^rel_ij.
+    pub(crate) d_rel: Vec<Vector3<f64>>,
+    pub(crate) delta_rel: Vec<Vector3<f64>>,
+    /// Work of the residual, per body: the accelerations (linear, angular) proportional to q̈
+    /// and the resultant (force, moment at G_i) of the inertia and applied forces of the body
+    /// and its descendants.
+    pub(crate) qdd_acceleration: Vec<(Vector3<f64>, Vector3<f64>)>,
+    pub(crate) subtree: Vec<(Vector3<f64>, Vector3<f64>)>,
     pub(crate) dependents: Vec<DependentValue>,
     /// Resultant applied force R_i and moment M_i at G_i, global frame (Eq. 3.35-3.36),
     /// gravity excluded (added by the equations of motion).
@@ -51,6 +62,11 @@ impl Data {
             accel_bias: vec![z; nb],
             d: vec![z; model.column_total],
             delta: vec![z; model.column_total],
+            complete: false,
+            d_rel: vec![z; model.own_total],
+            delta_rel: vec![z; model.own_total],
+            qdd_acceleration: vec![(z, z); nb],
+            subtree: vec![(z, z); nb],
             dependents,
             force: vec![z; nb],
             moment: vec![z; nb],
@@ -90,6 +106,7 @@ impl Data {
     }
     /// Linear acceleration of G_b for the accelerations q̈ (Eq. 3.27).
     pub fn acceleration(&self, model: &Model, b: BodyId, qdd: &[f64]) -> Vector3<f64> {
+        self.assert_complete();
         let body = &model.bodies[b.0];
         let mut a = self.accel_bias[b.0];
         for (k, &c) in body.columns.iter().enumerate() {
@@ -99,6 +116,7 @@ impl Data {
     }
     /// Angular acceleration of body b for q̈ (Eq. 3.34).
     pub fn angular_acceleration(&self, model: &Model, b: BodyId, qdd: &[f64]) -> Vector3<f64> {
+        self.assert_complete();
         let body = &model.bodies[b.0];
         let mut a = self.alpha_bias[b.0];
         for (k, &c) in body.columns.iter().enumerate() {
@@ -108,6 +126,7 @@ impl Data {
     }
     /// The non-zero columns of J_S and J_ω of body b: (coordinate j, d_bj, δ_bj).
     pub fn partial_velocities<'a>(&'a self, model: &'a Model, b: BodyId) -> impl Iterator<Item = (usize, Vector3<f64>, Vector3<f64>)> + 'a {
+        self.assert_complete();
         let body = &model.bodies[b.0];
         body.columns.iter().enumerate().map(move |(k, &c)| (c, self.d[body.offset + k], self.delta[body.offset + k]))
     }
@@ -115,6 +134,12 @@ impl Data {
     pub fn point_partial_velocities<'a>(&'a self, model: &'a Model, b: BodyId, p: &Vector3<f64>) -> impl Iterator<Item = (usize, Vector3<f64>)> + 'a {
         let r = p - self.pose[b.0].translation;
         self.partial_velocities(model, b).map(move |(c, d, delta)| (c, d + delta.cross(&r)))
+    }
+
+    /// The partial velocities of every body are only available after [`super::kinematics`] or
+    /// [`super::partial_velocities`] ([`super::relative_kinematics`] leaves them out).
+    pub(crate) fn assert_complete(&self) {
+        assert!(self.complete, "partial velocities not computed: call mbs::partial_velocities after mbs::relative_kinematics");
     }
 
     /// Removes all applied forces (start of an evaluation).

@@ -4,6 +4,9 @@
 //! convective acceleration and the partial velocities d_ij, δ_ij are carried through the
 //! elementary transforms of the body's joint. A translation by s along unit axis e (global
 //! direction) at offset r adds d_j += δ_j × r + e ∂s/∂q_j; a rotation adds δ_j += e ∂s/∂q_j.
+//! Only the columns of the joint's own variables change along the joint: the reference body's
+//! partial velocities ride along rigidly, so they are kept relative to it (and summed into the
+//! full d_ij, δ_ij only when asked for, e.g. for the mass matrix).
 
 use nalgebra::{DMatrix, Vector3};
 
@@ -44,8 +47,19 @@ fn add_gradient(var: &CompiledVar, dependents: &[super::DependentValue], e: &Vec
 }
 
 /// Evaluates dependent parameters, then poses, velocities, convective accelerations and
-/// partial velocities of all bodies at (q, q̇).
+/// partial velocities of all bodies at (q, q̇): [`relative_kinematics`] then
+/// [`partial_velocities`].
 pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
+    relative_kinematics(model, data, q, qd);
+    partial_velocities(model, data);
+}
+
+/// Evaluates dependent parameters, then poses, velocities and convective accelerations of all
+/// bodies at (q, q̇), and the partial velocities of each body relative to its reference body
+/// over the columns of its own joint: all that [`super::residual`] needs. The partial velocities
+/// of the bodies themselves (the mass matrix, [`Data::partial_velocities`]) follow from
+/// [`partial_velocities`].
+pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
     debug_assert_eq!(q.len(), model.coordinates);
     for g in &model.dependents {
         let (x, xd) = &mut data.input_work;
@@ -57,26 +71,19 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
         let out = &mut data.dependents[g.first_output..g.first_output + no];
         dependent::evaluate(g.function.as_ref(), x, xd, out, &mut data.dual_work);
     }
+    data.complete = false;
     for (i, body) in model.bodies.iter().enumerate() {
-        let n = body.columns.len();
         let (mut pose, mut omega, mut vel, mut alpha, mut acc) = match body.parent {
             Some(p) => (data.pose[p], data.omega[p], data.velocity[p], data.alpha_bias[p], data.accel_bias[p]),
             None => (Htm::identity(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
         };
-        // Columns of this body: start from the parent's.
-        let (head, tail) = data.d.split_at_mut(body.offset);
-        let d = &mut tail[..n];
-        let (dhead, dtail) = data.delta.split_at_mut(body.offset);
-        let delta = &mut dtail[..n];
+        // The reference body's partial velocities are carried rigidly (see `partial_velocities`):
+        // only the own columns of the joint are propagated here.
+        let n = body.own.len();
+        let d = &mut data.d_rel[body.own_offset..body.own_offset + n];
+        let delta = &mut data.delta_rel[body.own_offset..body.own_offset + n];
         d.iter_mut().for_each(|x| *x = Vector3::zeros());
         delta.iter_mut().for_each(|x| *x = Vector3::zeros());
-        if let Some(p) = body.parent {
-            let parent = &model.bodies[p];
-            for (k, &pos) in body.parent_columns.iter().enumerate() {
-                d[pos] = head[parent.offset + k];
-                delta[pos] = dhead[parent.offset + k];
-            }
-        }
         for e in &body.joint {
             match e {
                 CompiledElementary::Fixed(h) => {
@@ -116,6 +123,39 @@ pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
         data.alpha_bias[i] = alpha;
         data.accel_bias[i] = acc;
     }
+}
+
+/// The partial velocities d_ij and δ_ij of every body (Eq. 3.24, 3.31) after
+/// [`relative_kinematics`]: those of the reference body p carried rigidly to G_i,
+/// d_ij = d_pj + δ_pj × (p_i − p_p), δ_ij = δ_pj, plus the relative ones of the body's joint.
+/// Does nothing when they are already complete.
+pub fn partial_velocities(model: &Model, data: &mut Data) {
+    if data.complete {
+        return;
+    }
+    for (i, body) in model.bodies.iter().enumerate() {
+        let n = body.columns.len();
+        let (head, tail) = data.d.split_at_mut(body.offset);
+        let d = &mut tail[..n];
+        let (dhead, dtail) = data.delta.split_at_mut(body.offset);
+        let delta = &mut dtail[..n];
+        d.iter_mut().for_each(|x| *x = Vector3::zeros());
+        delta.iter_mut().for_each(|x| *x = Vector3::zeros());
+        if let Some(p) = body.parent {
+            let parent = &model.bodies[p];
+            let r = data.pose[i].translation - data.pose[p].translation;
+            for (k, &pos) in body.parent_columns.iter().enumerate() {
+                let dp = dhead[parent.offset + k];
+                d[pos] = head[parent.offset + k] + dp.cross(&r);
+                delta[pos] = dp;
+            }
+        }
+        for (k, &pos) in body.own_columns.iter().enumerate() {
+            d[pos] += data.d_rel[body.own_offset + k];
+            delta[pos] += data.delta_rel[body.own_offset + k];
+        }
+    }
+    data.complete = true;
 }
 
 /// Partial velocities estimated by numerical derivation of the positions (central differences

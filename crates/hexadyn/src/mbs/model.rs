@@ -130,7 +130,8 @@ pub(crate) struct DependentGroup {
 #[derive(Clone, Debug)]
 pub(crate) struct CompiledVar {
     pub var: Var,
-    /// For each input of the source (1 for a coordinate): position in the body's column list.
+    /// For each input of the source (1 for a coordinate): position in the body's own columns
+    /// ([`Body::own`]).
     pub columns: Vec<usize>,
 }
 
@@ -155,6 +156,14 @@ pub(crate) struct Body {
     pub parent_columns: Vec<usize>,
     /// Offset of this body's columns in the flat partial-velocity arrays of [`super::Data`].
     pub offset: usize,
+    /// Sorted configuration parameters the body's own joint depends on (directly or through
+    /// dependent parameters): the columns of its partial velocities relative to its reference
+    /// body.
+    pub own: Vec<usize>,
+    /// Position in `columns` of each of `own`.
+    pub own_columns: Vec<usize>,
+    /// Offset of the own columns in the flat relative partial-velocity arrays of [`super::Data`].
+    pub own_offset: usize,
 }
 
 /// Immutable multibody description (Model/Data split). Cheap to clone: dependent functions
@@ -166,6 +175,7 @@ pub struct Model {
     pub(crate) dependents: Vec<DependentGroup>,
     pub(crate) dependent_count: usize,
     pub(crate) column_total: usize,
+    pub(crate) own_total: usize,
     /// Gravity acceleration in the global frame (m/s²).
     pub gravity: Vector3<f64>,
 }
@@ -274,19 +284,25 @@ impl ModelBuilder {
 
     pub fn build(self) -> Model {
         let mut bodies: Vec<Body> = Vec::with_capacity(self.specs.len());
-        let mut offset = 0;
+        let (mut offset, mut own_offset) = (0, 0);
         for spec in &self.specs {
-            let mut columns: Vec<usize> = spec.parent.map(|p| bodies[p.0].columns.clone()).unwrap_or_default();
+            let mut own: Vec<usize> = Vec::new();
             for e in &spec.joint {
                 if let Elementary::Rotation { var, .. } | Elementary::Translation { var, .. } = e {
-                    columns.extend(self.source_inputs(var.source));
+                    own.extend(self.source_inputs(var.source));
                 }
             }
+            own.sort_unstable();
+            own.dedup();
+            let mut columns: Vec<usize> = spec.parent.map(|p| bodies[p.0].columns.clone()).unwrap_or_default();
+            columns.extend(&own);
             columns.sort_unstable();
             columns.dedup();
             let pos = |c: usize| columns.binary_search(&c).expect("column present");
             let parent_columns = spec.parent.map(|p| bodies[p.0].columns.iter().map(|&c| pos(c)).collect()).unwrap_or_default();
-            let compile = |var: &Var| CompiledVar { var: *var, columns: self.source_inputs(var.source).into_iter().map(pos).collect() };
+            let own_columns = own.iter().map(|&c| pos(c)).collect();
+            let own_pos = |c: usize| own.binary_search(&c).expect("own column present");
+            let compile = |var: &Var| CompiledVar { var: *var, columns: self.source_inputs(var.source).into_iter().map(own_pos).collect() };
             // Consecutive constant HTMs are multiplied once here rather than at every evaluation.
             let mut joint: Vec<CompiledElementary> = Vec::with_capacity(spec.joint.len());
             for e in &spec.joint {
@@ -297,7 +313,7 @@ impl ModelBuilder {
                     (Elementary::Translation { axis, var }, _) => joint.push(CompiledElementary::Translation { axis: *axis, var: compile(var) }),
                 }
             }
-            let n = columns.len();
+            let (n, n_own) = (columns.len(), own.len());
             bodies.push(Body {
                 name: spec.name.clone(),
                 parent: spec.parent.map(|p| p.0),
@@ -307,8 +323,12 @@ impl ModelBuilder {
                 columns,
                 parent_columns,
                 offset,
+                own,
+                own_columns,
+                own_offset,
             });
             offset += n;
+            own_offset += n_own;
         }
         Model {
             coordinates: self.coordinates,
@@ -316,6 +336,7 @@ impl ModelBuilder {
             dependents: self.dependents,
             dependent_count: self.dependent_count,
             column_total: offset,
+            own_total: own_offset,
             gravity: self.gravity,
         }
     }

@@ -1,6 +1,6 @@
 //! A multibody system as a [`crate::sim::System`].
 
-use super::{kinematics, mass_matrix, residual, Data, Model};
+use super::{mass_matrix, partial_velocities, relative_kinematics, residual, Data, Model};
 use crate::sim::{finite_difference_jacobian, Jacobian, Layout, Order, System};
 
 /// Applied forces of a multibody system, evaluated after the kinematics of each evaluation
@@ -40,9 +40,10 @@ impl<A: AppliedForces> MultibodySystem<A> {
         MultibodySystem { model, data, forces, layout }
     }
 
-    /// Kinematics and applied forces at (t, q, q̇).
+    /// Kinematics (relative partial velocities only, see [`relative_kinematics`]) and applied
+    /// forces at (t, q, q̇).
     pub fn evaluate(&mut self, t: f64, q: &[f64], qd: &[f64]) {
-        kinematics(&self.model, &mut self.data, q, qd);
+        relative_kinematics(&self.model, &mut self.data, q, qd);
         self.data.clear_forces();
         self.forces.apply(&self.model, &mut self.data, t, q, qd);
     }
@@ -54,7 +55,7 @@ impl<A: AppliedForces> System for MultibodySystem<A> {
     }
     fn residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.evaluate(t, q, qd);
-        residual(&self.model, &self.data, qdd, f);
+        residual(&self.model, &mut self.data, qdd, f);
     }
     /// M exact (Eq. 3.39); CT and KT by finite differences (the inertia and applied-force
     /// terms depend on q through the whole kinematics).
@@ -63,6 +64,7 @@ impl<A: AppliedForces> System for MultibodySystem<A> {
         jac.ct = fd.ct;
         jac.kt = fd.kt;
         self.evaluate(t, q, qd);
+        partial_velocities(&self.model, &mut self.data);
         mass_matrix(&self.model, &self.data, &mut jac.m);
         true
     }

@@ -318,13 +318,20 @@ impl Robot {
         &self.data
     }
 
-    /// Kinematics of the multibody coordinates at (q, q') into `data`, unless it holds them.
+    /// Kinematics of the multibody coordinates at (q, q') into `data`, unless it holds them:
+    /// what the residual needs ([`mbs::relative_kinematics`]); see [`Self::partial_velocities`]
+    /// for the rest.
     fn kinematics(&mut self, q: &[f64], qd: &[f64]) {
         let at = (q[..DOF].try_into().expect("DOF coordinates"), qd[..DOF].try_into().expect("DOF coordinates"));
         if self.kinematics_at != Some(at) {
-            mbs::kinematics(&self.model.mechanics.model, &mut self.data, &q[..DOF], &qd[..DOF]);
+            mbs::relative_kinematics(&self.model.mechanics.model, &mut self.data, &q[..DOF], &qd[..DOF]);
             self.kinematics_at = Some(at);
         }
+    }
+
+    /// The partial velocities of every body at the last kinematics (mass matrix, foot Jacobians).
+    fn partial_velocities(&mut self) {
+        mbs::partial_velocities(&self.model.mechanics.model, &mut self.data);
     }
 
     /// Multibody rows with the contact and joint forces frozen at `contact` and `joint`
@@ -341,7 +348,7 @@ impl Robot {
         for (k, tau) in joint.iter().enumerate() {
             self.data.add_generalized_force(6 + k, *tau);
         }
-        mbs::residual(&mech.model, &self.data, &qdd[..DOF], &mut f[..DOF]);
+        mbs::residual(&mech.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
     }
 
     /// Central differences of [`Self::frozen_residual`] over q and q' (Eq. 3.12).
@@ -440,7 +447,7 @@ impl Robot {
     fn write_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.evaluate(q, qd, qdd);
         let m = &*self.model;
-        mbs::residual(&m.mechanics.model, &self.data, &qdd[..DOF], &mut f[..DOF]);
+        mbs::residual(&m.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
         for k in 0..JOINTS {
             let j = 6 + k;
             if let Some(b) = m.bristles {
@@ -507,6 +514,7 @@ impl System for Robot {
             self.inertial = Some(self.inertial_jacobian(q, qd, qdd));
         }
         self.evaluate(q, qd, qdd);
+        self.partial_velocities();
         self.write_mass_matrix(qd, qdd, &mut jac.m);
         let inertial = self.inertial.as_ref().expect("taken above");
         jac.kt.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.kt);
@@ -606,6 +614,7 @@ impl System for Robot {
 
     fn mass_matrix(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], m: &mut DMatrix<f64>) -> bool {
         self.evaluate(q, qd, qdd);
+        self.partial_velocities();
         self.write_mass_matrix(qd, qdd, m);
         true
     }
