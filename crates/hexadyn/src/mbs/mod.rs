@@ -21,5 +21,5 @@ pub use dependent::{DependentFunction, DependentValue};
 pub use num_dual::{Dual2_64, DualNum};
 pub use dynamics::{generalized_forces, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, residual};
 pub use kinematics::{kinematics, partial_velocities, partial_velocities_numerical, relative_kinematics};
-pub use model::{BodyId, BodySpec, Elementary, Model, ModelBuilder, ModelError, Var};
+pub use model::{BodyId, BodySpec, Elementary, Model, ModelBuilder, ModelError, Var, STANDARD_GRAVITY};
 pub use system::{AppliedForces, MultibodySystem};

@@ -205,6 +205,9 @@ impl Model {
     }
 }
 
+/// Standard gravity g (m/s²): the default gravity of a [`Model`], along −z.
+pub const STANDARD_GRAVITY: f64 = 9.81;
+
 /// Builds a [`Model`] body after body.
 #[derive(Debug)]
 pub struct ModelBuilder {
@@ -218,7 +221,7 @@ pub struct ModelBuilder {
 impl ModelBuilder {
     /// A model with `coordinates` configuration parameters and gravity -9.81 z.
     pub fn new(coordinates: usize) -> Self {
-        ModelBuilder { coordinates, specs: Vec::new(), dependents: Vec::new(), dependent_count: 0, gravity: Vector3::new(0.0, 0.0, -9.81) }
+        ModelBuilder { coordinates, specs: Vec::new(), dependents: Vec::new(), dependent_count: 0, gravity: Vector3::new(0.0, 0.0, -STANDARD_GRAVITY) }
     }
     pub fn gravity(mut self, g: Vector3<f64>) -> Self {
         self.gravity = g;

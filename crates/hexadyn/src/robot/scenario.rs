@@ -954,10 +954,11 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     Ok(ScenarioResults { series, summary })
 }
 
-/// Specific resistance xi = E / (m g l) (Eq. 6.6), g = 9.81 m/s^2; NaN when nothing was walked.
+/// Specific resistance xi = E / (m g l) (Eq. 6.6), g the standard gravity of the multibody
+/// model; NaN when nothing was walked.
 pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 {
     if distance_m > 0.0 {
-        energy_j / (mass_kg * crate::physics::LOAD_GRAVITY * distance_m)
+        energy_j / (mass_kg * crate::mbs::STANDARD_GRAVITY * distance_m)
     } else {
         f64::NAN
     }
