@@ -35,13 +35,14 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 import pandas as pd
 
+from hexadyn._core import STANDARD_GRAVITY
 from hexadyn.results import parse_toml
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
 
-#: Gravity (m/s²), as in the engine's multibody model.
-G = 9.81
+#: Gravity g (m/s²) of Eq. 6.6: the engine's multibody gravity (``mbs::STANDARD_GRAVITY``).
+G = STANDARD_GRAVITY
 
 #: Joint types in the order of the thesis tables: rotation, vertical, horizontal.
 JOINT_TYPES = ("q_r", "q_v", "q_h")

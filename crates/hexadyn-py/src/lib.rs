@@ -9,6 +9,7 @@ mod scenario;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("STANDARD_GRAVITY", hexadyn::mbs::STANDARD_GRAVITY)?;
     m.add_class::<mbs::PyMultibody>()?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;

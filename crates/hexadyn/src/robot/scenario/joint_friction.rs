@@ -20,7 +20,7 @@
 
 use serde::Deserialize;
 
-use crate::robot::description::{Ctx, DescriptionError, Measured, PerLeg, PerLegMaybe};
+use crate::robot::description::{Ctx, DescriptionError, Measured, PerLeg};
 use crate::robot::{Joint, RobotDescription};
 
 /// The raw `[model.joint_friction]` table.
@@ -127,13 +127,9 @@ impl RawJointParameters {
         }
         for (table, value) in [(&mut ld.a_1_plus_n_per_kg, a_1_plus), (&mut ld.a_1_minus_n_per_kg, a_1_minus)] {
             if let Some(v) = value {
-                fill_measured(table, v);
+                table.mu.fill(Measured::Value(v));
             }
         }
         Ok(())
     }
-}
-
-fn fill_measured(table: &mut PerLegMaybe, v: f64) {
-    table.mu.fill(Measured::Value(v));
 }
