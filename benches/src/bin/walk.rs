@@ -31,8 +31,8 @@ fn main() {
     ];
     println!("hexadyn walk benchmark: tripod walks end to end (settling, gait controller, recording), single core");
     println!(
-        "{:<38} {:>7} {:>6} {:>9} {:>6} {:>5} {:>7} {:>5} {:>5} {:>9} {:>8} {:>8} {:>9}",
-        "case", "wall s", "RTF", "vs thesis", "steps", "rej.", "Newton", "Jac.", "LU", "energy %", "q_r mrad", "q_v mm", "XY err mm"
+        "{:<38} {:>7} {:>6} {:>9} {:>6} {:>5} {:>7} {:>7} {:>5} {:>5} {:>9} {:>8} {:>8} {:>9}",
+        "case", "wall s", "RTF", "vs thesis", "steps", "rej.", "Newton", "f eval.", "Jac.", "LU", "energy %", "q_r mrad", "q_v mm", "XY err mm"
     );
     let only: Option<usize> = std::env::args().nth(1).map(|a| a.parse().unwrap());
     for (i, (name, s)) in cases.iter().enumerate() {
@@ -44,7 +44,7 @@ fn main() {
         let tracking = m.max_tracking_error.unwrap_or([f64::NAN; 3]);
         let xy = m.gait.as_ref().map_or(f64::NAN, |g| g.tracking_error_xy_max_m);
         println!(
-            "{:<38} {:>7.3} {:>6.0} {:>8.0}x {:>6} {:>5} {:>7} {:>5} {:>5} {:>9.4} {:>8.3} {:>8.4} {:>9.3}",
+            "{:<38} {:>7.3} {:>6.0} {:>8.0}x {:>6} {:>5} {:>7} {:>7} {:>5} {:>5} {:>9.4} {:>8.3} {:>8.4} {:>9.3}",
             name,
             wall,
             m.duration_s / wall,
@@ -52,6 +52,7 @@ fn main() {
             m.integration_steps,
             m.rejected_steps,
             m.newton_iterations,
+            m.residual_evaluations,
             m.jacobian_evaluations,
             m.factorizations,
             100.0 * m.energy_balance_error_relative,

@@ -51,6 +51,11 @@ impl Htm {
 /// equals the rotation blocks of Eq. A.2-A.4.
 pub fn rotation_about(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
     let (s, c) = angle.sin_cos();
+    rotation_about_sin_cos(axis, s, c)
+}
+
+/// [`rotation_about`] from the sine and cosine of the angle.
+fn rotation_about_sin_cos(axis: &Vector3<f64>, s: f64, c: f64) -> Matrix3<f64> {
     let (x, y, z) = (axis.x, axis.y, axis.z);
     // The unit axes of Eq. A.2-A.4 directly.
     match (x == 1.0, y == 1.0, z == 1.0) {
@@ -73,6 +78,47 @@ pub fn rotation_about(axis: &Vector3<f64>, angle: f64) -> Matrix3<f64> {
     )
 }
 
+/// A unit rotation or translation axis: one of the frame axes x, y, z (the elementary
+/// transforms of Eq. A.1-A.4, nearly every joint) or a general direction. Knowing the frame axis
+/// turns `R e` into a column of R and `R R^{Rx|Ry|Rz}(θ)` into a rotation of two columns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Axis {
+    /// Frame axis 0 (x), 1 (y) or 2 (z).
+    Frame(usize),
+    General(Vector3<f64>),
+}
+
+impl Axis {
+    /// The axis of the unit vector `e`, a frame axis when `e` is exactly one.
+    pub fn of(e: &Vector3<f64>) -> Axis {
+        match (0..3).find(|&k| e[k] == 1.0) {
+            Some(k) => Axis::Frame(k),
+            None => Axis::General(*e),
+        }
+    }
+    /// R e: the axis in the frame R maps from.
+    pub fn in_frame(&self, r: &Matrix3<f64>) -> Vector3<f64> {
+        match self {
+            Axis::Frame(k) => r.column(*k).into_owned(),
+            Axis::General(e) => r * e,
+        }
+    }
+    /// R ← R R_e(θ), with the sine and cosine of θ.
+    pub fn rotate(&self, r: &mut Matrix3<f64>, (s, c): (f64, f64)) {
+        match self {
+            Axis::Frame(k) => {
+                // About axis k the columns i = k + 1 and j = k + 2 (cyclic) turn:
+                // c_i' = c c_i + s c_j, c_j' = −s c_i + c c_j (Eq. A.2-A.4).
+                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+                let (ci, cj) = (r.column(i).into_owned(), r.column(j).into_owned());
+                r.set_column(i, &(ci * c + cj * s));
+                r.set_column(j, &(cj * c - ci * s));
+            }
+            Axis::General(e) => *r *= rotation_about_sin_cos(e, s, c),
+        }
+    }
+}
+
 /// The tilde operator of Eq. 3.29: `tilde(a) b = a × b`.
 pub fn tilde(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
@@ -87,6 +133,22 @@ pub fn yaw_pitch_roll(yaw: f64, pitch: f64, roll: f64) -> Matrix3<f64> {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    /// The column shortcuts of a frame axis give R e and R R_e(θ) as the matrix products do.
+    #[test]
+    fn axis_shortcuts_match_the_products() {
+        let r = yaw_pitch_roll(0.4, -0.7, 1.1);
+        let t = -0.83_f64;
+        let general = Vector3::new(1.0, -2.0, 0.5).normalize();
+        for (e, frame) in [(Vector3::x(), true), (Vector3::y(), true), (Vector3::z(), true), (general, false), (-Vector3::z(), false)] {
+            let axis = Axis::of(&e);
+            assert_eq!(matches!(axis, Axis::Frame(_)), frame, "{e:?}");
+            assert_relative_eq!(axis.in_frame(&r), r * e, epsilon = 1e-15);
+            let mut turned = r;
+            axis.rotate(&mut turned, t.sin_cos());
+            assert_relative_eq!(turned, r * rotation_about(&e, t), epsilon = 1e-15);
+        }
+    }
 
     #[test]
     fn elementary_rotations_match_appendix_a() {

@@ -13,7 +13,7 @@ use nalgebra::{DMatrix, Vector3};
 use super::data::Data;
 use super::dependent;
 use super::model::{CompiledElementary, CompiledVar, Model, Source};
-use crate::spatial::{rotation_about, Htm};
+use crate::spatial::Htm;
 
 /// Value, rate, convective second derivative and gradient (per compiled column) of a variable.
 struct VarState {
@@ -43,6 +43,16 @@ fn add_gradient(var: &CompiledVar, dependents: &[super::DependentValue], e: &Vec
                 target[col] += e * (v.scale * g);
             }
         }
+    }
+}
+
+/// Velocity, convective acceleration and relative partial velocities carried across a
+/// displacement r of the frame (rigid transport, Eq. 3.24-3.27).
+fn offset_motion(r: &Vector3<f64>, omega: &Vector3<f64>, alpha: &Vector3<f64>, vel: &mut Vector3<f64>, acc: &mut Vector3<f64>, d: &mut [Vector3<f64>], delta: &[Vector3<f64>]) {
+    *vel += omega.cross(r);
+    *acc += alpha.cross(r) + omega.cross(&omega.cross(r));
+    for (dk, deltak) in d.iter_mut().zip(delta) {
+        *dk += deltak.cross(r);
     }
 }
 
@@ -88,30 +98,30 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
             match e {
                 CompiledElementary::Fixed(h) => {
                     let r = pose.rotation * h.translation;
-                    vel += omega.cross(&r);
-                    acc += alpha.cross(&r) + omega.cross(&omega.cross(&r));
-                    for k in 0..n {
-                        d[k] += delta[k].cross(&r);
-                    }
-                    pose = pose.compose(h);
+                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
+                    pose.translation += r;
+                    pose.rotation *= h.rotation;
+                }
+                CompiledElementary::Offset(t) => {
+                    let r = pose.rotation * t;
+                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
+                    pose.translation += r;
                 }
                 CompiledElementary::Rotation { axis, var } => {
                     let s = var_state(var, q, qd, &data.dependents);
-                    let e = pose.rotation * axis;
+                    let e = axis.in_frame(&pose.rotation);
                     alpha += omega.cross(&e) * s.rate + e * s.bias;
                     omega += e * s.rate;
                     add_gradient(var, &data.dependents, &e, delta);
-                    pose.rotation *= rotation_about(axis, s.value);
+                    axis.rotate(&mut pose.rotation, s.value.sin_cos());
                 }
                 CompiledElementary::Translation { axis, var } => {
                     let s = var_state(var, q, qd, &data.dependents);
-                    let e = pose.rotation * axis;
+                    let e = axis.in_frame(&pose.rotation);
                     let r = e * s.value;
-                    vel += omega.cross(&r) + e * s.rate;
-                    acc += alpha.cross(&r) + omega.cross(&omega.cross(&r)) + omega.cross(&e) * (2.0 * s.rate) + e * s.bias;
-                    for k in 0..n {
-                        d[k] += delta[k].cross(&r);
-                    }
+                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
+                    vel += e * s.rate;
+                    acc += omega.cross(&e) * (2.0 * s.rate) + e * s.bias;
                     add_gradient(var, &data.dependents, &e, d);
                     pose.translation += r;
                 }

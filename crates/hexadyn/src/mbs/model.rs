@@ -5,7 +5,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::dependent::DependentFunction;
-use crate::spatial::Htm;
+use crate::spatial::{Axis, Htm};
 
 /// Index of a body in its [`Model`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -137,9 +137,12 @@ pub(crate) struct CompiledVar {
 
 #[derive(Clone, Debug)]
 pub(crate) enum CompiledElementary {
+    /// A constant HTM with a rotation.
     Fixed(Htm),
-    Rotation { axis: Vector3<f64>, var: CompiledVar },
-    Translation { axis: Vector3<f64>, var: CompiledVar },
+    /// A constant displacement T^d (Eq. A.1).
+    Offset(Vector3<f64>),
+    Rotation { axis: Axis, var: CompiledVar },
+    Translation { axis: Axis, var: CompiledVar },
 }
 
 #[derive(Clone, Debug)]
@@ -312,8 +315,15 @@ impl ModelBuilder {
                 match (e, joint.last_mut()) {
                     (Elementary::Fixed(h), Some(CompiledElementary::Fixed(previous))) => *previous = previous.compose(h),
                     (Elementary::Fixed(h), _) => joint.push(CompiledElementary::Fixed(*h)),
-                    (Elementary::Rotation { axis, var }, _) => joint.push(CompiledElementary::Rotation { axis: *axis, var: compile(var) }),
-                    (Elementary::Translation { axis, var }, _) => joint.push(CompiledElementary::Translation { axis: *axis, var: compile(var) }),
+                    (Elementary::Rotation { axis, var }, _) => joint.push(CompiledElementary::Rotation { axis: Axis::of(axis), var: compile(var) }),
+                    (Elementary::Translation { axis, var }, _) => joint.push(CompiledElementary::Translation { axis: Axis::of(axis), var: compile(var) }),
+                }
+            }
+            for e in &mut joint {
+                if let CompiledElementary::Fixed(h) = e {
+                    if h.rotation == Matrix3::identity() {
+                        *e = CompiledElementary::Offset(h.translation);
+                    }
                 }
             }
             let (n, n_own) = (columns.len(), own.len());

@@ -351,37 +351,36 @@ impl Robot {
         mbs::residual(&mech.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
     }
 
-    /// Central differences of [`Self::frozen_residual`] over q and q' (Eq. 3.12).
+    /// Forward differences of [`Self::frozen_residual`] over q and q' (Eq. 3.12): an iteration
+    /// matrix only needs the first digits, and one evaluation per column halves the cost of
+    /// central differences.
     fn inertial_jacobian(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) -> InertialJacobian {
         self.evaluate(q, qd, qdd);
         let contact = self.outputs.contact.map(|c| c.force);
         let joint: [f64; JOINTS] = std::array::from_fn(|k| self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
         let scales = self.model.layout.scales.clone();
         let mut jac = InertialJacobian { q: q.to_vec(), kt: DMatrix::zeros(DOF, DOF), ct: DMatrix::zeros(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6] };
-        let (mut fp, mut fm) = (vec![0.0; DOF], vec![0.0; DOF]);
-        let (mut vp, mut vm) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
+        let (mut f0, mut fp) = (vec![0.0; DOF], vec![0.0; DOF]);
+        let (mut v0, mut vp) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
+        self.frozen_residual(q, qd, qdd, &contact, &joint, &mut f0, &mut v0);
         let (mut x, mut xd) = (q.to_vec(), qd.to_vec());
         for j in 0..DOF {
             let step = 1e-6 * x[j].abs().max(1e3 * scales[j]);
             x[j] = q[j] + step;
             self.frozen_residual(&x, qd, qdd, &contact, &joint, &mut fp, &mut vp);
-            x[j] = q[j] - step;
-            self.frozen_residual(&x, qd, qdd, &contact, &joint, &mut fm, &mut vm);
             x[j] = q[j];
             for i in 0..DOF {
-                jac.kt[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+                jac.kt[(i, j)] = (fp[i] - f0[i]) / step;
             }
             for leg in 0..6 {
-                jac.dv_dq[leg].set_column(j, &((vp[leg] - vm[leg]) / (2.0 * step)));
+                jac.dv_dq[leg].set_column(j, &((vp[leg] - v0[leg]) / step));
             }
             let step = 1e-6 * xd[j].abs().max(1e2 * scales[j]);
             xd[j] = qd[j] + step;
             self.frozen_residual(q, &xd, qdd, &contact, &joint, &mut fp, &mut vp);
-            xd[j] = qd[j] - step;
-            self.frozen_residual(q, &xd, qdd, &contact, &joint, &mut fm, &mut vm);
             xd[j] = qd[j];
             for i in 0..DOF {
-                jac.ct[(i, j)] = (fp[i] - fm[i]) / (2.0 * step);
+                jac.ct[(i, j)] = (fp[i] - f0[i]) / step;
             }
         }
         jac

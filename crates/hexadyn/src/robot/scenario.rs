@@ -760,6 +760,9 @@ pub struct Summary {
     pub integration_steps: u64,
     pub rejected_steps: u64,
     pub newton_iterations: u64,
+    /// Evaluations of the residual f by the integrator: Newton iterations and consistent
+    /// accelerations (those inside a Jacobian evaluation are not counted).
+    pub residual_evaluations: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,
     /// Body height Z at the start (after settling and offset).
@@ -816,6 +819,7 @@ impl Summary {
             ("integration_steps", Count(self.integration_steps)),
             ("rejected_steps", Count(self.rejected_steps)),
             ("newton_iterations", Count(self.newton_iterations)),
+            ("residual_evaluations", Count(self.residual_evaluations)),
             ("jacobian_evaluations", Count(self.jacobian_evaluations)),
             ("factorizations", Count(self.factorizations)),
             ("initial_body_height_m", Number(self.initial_body_height_m)),
@@ -1025,6 +1029,7 @@ fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &
         integration_steps: n.steps as u64,
         rejected_steps: n.rejected_steps as u64,
         newton_iterations: n.newton_iterations as u64,
+        residual_evaluations: n.residual_evaluations as u64,
         jacobian_evaluations: n.jacobian_evaluations as u64,
         factorizations: n.factorizations as u64,
         initial_body_height_m: q0[2],

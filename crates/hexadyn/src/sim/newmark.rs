@@ -6,6 +6,10 @@ use super::error::largest_rows;
 use super::jacobian::mass_matrix;
 use super::{Jacobian, Order, SimError, System};
 
+/// A kept factorization of M is used as long as each Newton correction of the consistent
+/// accelerations is at least this many times smaller than the one before.
+const FAST_CONTRACTION: f64 = 0.1;
+
 /// Integration parameters. Defaults: the trapezoidal rule β = 1/4, γ = 1/2 (unconditionally
 /// stable for linear systems, second order, no numerical damping).
 #[derive(Clone, Debug, PartialEq)]
@@ -96,6 +100,8 @@ pub struct Newmark {
     lu: Option<(LU<f64, nalgebra::Dyn, nalgebra::Dyn>, f64)>,
     /// True when `jacobian` was evaluated during the current step (refreshing it again is useless).
     jacobian_fresh: bool,
+    /// Factorization of M = ∂f/∂q'' kept for [`Self::reset_accelerations`].
+    mass_lu: Option<LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
     stats: NewmarkStats,
     work: Work,
 }
@@ -129,6 +135,7 @@ impl Newmark {
             jacobian: None,
             lu: None,
             jacobian_fresh: false,
+            mass_lu: None,
             stats: NewmarkStats::default(),
             work: Work { f: vec![0.0; n], q: DVector::zeros(n), qd: DVector::zeros(n), qdd: DVector::zeros(n), weight_q: DVector::zeros(n) },
         };
@@ -158,30 +165,61 @@ impl Newmark {
     /// jumped (zero-order hold at a control instant), so that the error estimate of the next step
     /// does not see the discontinuity. Uses Newton on M = ∂f/∂q''; when M is singular (algebraic
     /// rows) q'' is left as it is and the next Newmark step restores consistency.
+    ///
+    /// The factorization of M is kept from one call to the next (the configuration moves little
+    /// between control instants) and refreshed only when the iteration with it does not contract
+    /// fast: modified Newton, as in the steps.
     pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
+        let start = self.state.qdd.clone();
+        if self.mass_lu.is_some() {
+            if self.consistent_accelerations(sys, FAST_CONTRACTION)? {
+                return Ok(());
+            }
+            self.state.qdd.copy_from(&start);
+        }
         let t = self.state.t;
         let (m, direct) = mass_matrix(sys, t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice());
         if !direct {
             self.stats.jacobian_evaluations += 1;
         }
         let lu = LU::new(m);
+        self.stats.factorizations += 1;
         if !lu.is_invertible() {
+            self.mass_lu = None;
             return Ok(());
         }
+        self.mass_lu = Some(lu);
+        self.consistent_accelerations(sys, 1.0)?;
+        Ok(())
+    }
+
+    /// Newton iterations q'' ← q'' − M⁻¹ f with the kept factorization of M, until the
+    /// correction passes the Newton test of the next step (true) or is not at least
+    /// `contraction` times smaller than the one before (false).
+    fn consistent_accelerations<S: System + ?Sized>(&mut self, sys: &mut S, contraction: f64) -> Result<bool, SimError> {
+        let t = self.state.t;
+        self.weights(sys);
+        let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, self.h);
+        let mut previous = f64::INFINITY;
         for _ in 0..self.options.max_iterations {
             sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
             self.stats.residual_evaluations += 1;
             check_finite(sys, t, None, &self.work.f)?;
+            let lu = self.mass_lu.as_ref().expect("factorized");
             let Some(dx) = lu.solve(&DVector::from_column_slice(&self.work.f)) else {
-                return Ok(());
+                return Ok(false);
             };
             self.state.qdd -= &dx;
-            let scale = dx.iter().zip(self.state.qdd.iter()).map(|(d, a)| d.abs() / (1.0 + a.abs())).fold(0.0, f64::max);
-            if scale < 1e-10 {
-                break;
+            let norm = test.norm(&dx, &self.work.weight_q);
+            if test.converged(norm, &dx, &self.state.qdd) {
+                return Ok(true);
             }
+            if !(norm <= contraction * previous) {
+                return Ok(false);
+            }
+            previous = norm;
         }
-        Ok(())
+        Ok(false)
     }
 
     /// Integrates up to exactly `t_end` with adaptive steps (Eq. 3.15): on return `state().t == t_end`.
@@ -271,35 +309,9 @@ impl Newmark {
     /// matrix of Eq. 3.14, then the error estimate of Eq. 3.15.
     fn step<S: System + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<StepOutcome, SimError> {
         let t_new = self.state.t + h;
-        let n = self.state.q.len();
         self.weights(sys);
         self.jacobian_fresh = false;
-        let (b, g) = (self.options.beta, self.options.gamma);
-        let orders: Vec<Order> = sys.layout().orders.clone();
-        // Newton corrections are measured on the integrated quantity: q (βh² Δq'') for
-        // second-order coordinates and q' (γh Δq'') for first-order ones.
-        let unit: Vec<f64> = orders.iter().map(|o| match o {
-            Order::Second => b * h * h,
-            Order::First => g * h,
-        }).collect();
-        let converge_at = self.options.newton_tolerance * self.options.tolerance;
-        // The last correction must also be small against q'' itself (`newton_tolerance` relative),
-        // with an absolute floor equal to what the test above allows at h_max: as h → 0 the
-        // q-unit test alone accepts any bounded q'' (βh² Δq'' vanishes), so an iteration that
-        // does not converge at all, e.g. on a residual without a root, would pass silently.
-        let h_ref = if self.options.h_max.is_finite() { self.options.h_max.max(h) } else { h };
-        let floor: Vec<f64> = orders
-            .iter()
-            .enumerate()
-            .map(|(i, o)| {
-                converge_at / self.work.weight_q[i]
-                    / match o {
-                        Order::Second => b * h_ref * h_ref,
-                        Order::First => g * h_ref,
-                    }
-            })
-            .collect();
-        let relative = self.options.newton_tolerance;
+        let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, h);
         'attempt: loop {
             // Predictor q''(t+h) = q''(t) first: a missing Jacobian is evaluated there.
             self.work.qdd.copy_from(&self.state.qdd);
@@ -322,11 +334,11 @@ impl Newmark {
                 let (lu, _) = self.lu.as_ref().expect("factorized");
                 let Some(dx) = lu.solve(&rhs) else { break };
                 self.work.qdd -= &dx;
-                let norm = (0..n).map(|i| (dx[i] * unit[i] * self.work.weight_q[i]).powi(2)).sum::<f64>().sqrt() / (n as f64).sqrt();
+                let norm = test.norm(&dx, &self.work.weight_q);
                 if !norm.is_finite() {
                     break;
                 }
-                if norm <= converge_at && (0..n).all(|i| dx[i].abs() <= relative * self.work.qdd[i].abs() + floor[i]) {
+                if test.converged(norm, &dx, &self.work.qdd) {
                     self.update_kinematics(h);
                     return Ok(self.accept_or_reject(sys, h));
                 }
@@ -425,6 +437,49 @@ impl Newmark {
     fn fastest_rows<S: System + ?Sized>(&self, sys: &S) -> Vec<super::ResidualRow> {
         let d: Vec<f64> = (0..self.state.q.len()).map(|i| (self.work.qdd[i] - self.state.qdd[i]) / sys.layout().scales[i]).collect();
         largest_rows(sys.layout(), &d, 5)
+    }
+}
+
+/// The Newton convergence test of a step of size h.
+struct NewtonTest {
+    /// Newton corrections are measured on the integrated quantity: q (βh² Δq'') for
+    /// second-order coordinates and q' (γh Δq'') for first-order ones.
+    unit: Vec<f64>,
+    /// The last correction must also be small against q'' itself (`newton_tolerance` relative),
+    /// with an absolute floor equal to what the test on the integrated quantities allows at
+    /// h_max: as h → 0 that test alone accepts any bounded q'' (βh² Δq'' vanishes), so an
+    /// iteration that does not converge at all, e.g. on a residual without a root, would pass
+    /// silently.
+    floor: Vec<f64>,
+    converge_at: f64,
+    relative: f64,
+}
+
+impl NewtonTest {
+    fn new(options: &NewmarkOptions, orders: &[Order], weight: &DVector<f64>, h: f64) -> Self {
+        let (b, g) = (options.beta, options.gamma);
+        let unit_at = |o: &Order, h: f64| match o {
+            Order::Second => b * h * h,
+            Order::First => g * h,
+        };
+        let converge_at = options.newton_tolerance * options.tolerance;
+        let h_ref = if options.h_max.is_finite() { options.h_max.max(h) } else { h };
+        NewtonTest {
+            unit: orders.iter().map(|o| unit_at(o, h)).collect(),
+            floor: orders.iter().zip(weight.iter()).map(|(o, w)| converge_at / w / unit_at(o, h_ref)).collect(),
+            converge_at,
+            relative: options.newton_tolerance,
+        }
+    }
+
+    /// RMS of the correction of the integrated quantities, in units of their scales.
+    fn norm(&self, dx: &DVector<f64>, weight: &DVector<f64>) -> f64 {
+        let n = dx.len();
+        (0..n).map(|i| (dx[i] * self.unit[i] * weight[i]).powi(2)).sum::<f64>().sqrt() / (n as f64).sqrt()
+    }
+
+    fn converged(&self, norm: f64, dx: &DVector<f64>, qdd: &DVector<f64>) -> bool {
+        norm <= self.converge_at && (0..dx.len()).all(|i| dx[i].abs() <= self.relative * qdd[i].abs() + self.floor[i])
     }
 }
 
