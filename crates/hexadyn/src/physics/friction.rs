@@ -205,6 +205,12 @@ pub struct LuGre {
 }
 
 impl LuGre {
+    /// The smaller steady-state bristle deflection while sliding, min(τ_f,d^+, −τ_f,d^-) / σ0
+    /// (Eq. 3.80 with g of Eq. 6.2-6.5 away from zero velocity): the size of z in motion.
+    pub fn sliding_deflection(&self) -> f64 {
+        self.steady.dry(1.0).min(-self.steady.dry(-1.0)) / self.sigma_0
+    }
+
     /// The LuGre law with σ0, σ1 of Table 6.1 and v_d = q'_st of Table 6.1 (Olsson's choice of
     /// v_d "in relation to the Stribeck velocity", Section 3.4.3; the thesis gives no value).
     /// Negative (non-physical) viscous coefficients are forced to zero as in Section 6.1.
@@ -609,6 +615,17 @@ mod tests {
             assert!((tau - stribeck).abs() < 1e-9 * stribeck.abs(), "v = {v}: {tau} vs Eq. 3.82 {stribeck}");
             assert!((z - law.g(v) * v.signum()).abs() < 1e-12 * law.g(v), "Eq. 3.80 at v = {v}");
         }
+    }
+
+    /// Far from zero velocity g (Eq. 3.78) is τ_f,d / σ0 in each direction: the sliding
+    /// deflection is the smaller of the two, and below the stiction deflection.
+    #[test]
+    fn sliding_deflection_is_the_smaller_steady_deflection_in_motion() {
+        let law = vertical_leg0();
+        let (forward, backward) = (law.g(1.0), law.g(-1.0));
+        assert!((forward - backward).abs() > 1e-3 * forward, "the test needs asymmetric dry friction");
+        assert!((law.sliding_deflection() - forward.min(backward)).abs() < 1e-12 * forward);
+        assert!(law.sliding_deflection() < law.g(0.0));
     }
 
     #[test]

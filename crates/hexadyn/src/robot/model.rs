@@ -28,6 +28,12 @@ use crate::sim::{Jacobian, Layout, Order, System};
 
 pub use crate::control::JOINTS;
 
+/// Error scale of a bristle deflection z (Eq. 3.85) as a fraction of its steady-state value
+/// while sliding ([`LuGre::sliding_deflection`]): z carries the friction torque σ0 z, so its
+/// error is measured against the deflection that holds the dry friction, the same relative
+/// accuracy for every joint whatever its σ0 and τ_f,d.
+const BRISTLE_SCALE: f64 = 1.0 / 30.0;
+
 /// Joint friction model of a simulation (Section 6.1: the three cases compared in Chapter 6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -171,8 +177,10 @@ impl RobotModel {
         }
         let bristles = (options.friction == FrictionModel::LuGre).then(|| {
             let first = layout.len();
-            for k in 0..JOINTS {
-                layout.push(format!("z_{}", joint_name(k)), Order::First, 1e-10, format!("LuGre bristle {}", joint_name(k)));
+            for (k, f) in friction.iter().enumerate() {
+                let JointFriction::LuGre(law) = &f.law else { unreachable!("LuGre friction on every joint") };
+                let scale = BRISTLE_SCALE * law.sliding_deflection();
+                layout.push(format!("z_{}", joint_name(k)), Order::First, scale, format!("LuGre bristle {}", joint_name(k)));
             }
             first
         });
