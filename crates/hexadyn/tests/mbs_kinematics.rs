@@ -7,7 +7,7 @@ mod mbs_models;
 
 use approx::assert_relative_eq;
 use mbs_models::tree;
-use hexadyn::mbs::{kinematics, partial_velocities_numerical, BodySpec, Data, DependentFunction, Dual2_64, DualNum, Elementary, Model, ModelBuilder, Var};
+use hexadyn::mbs::{kinematics, partial_velocities_numerical, BodySpec, Data, DependentFunction, DualNum, Elementary, Jet, Model, ModelBuilder, ModelError, Var, MAX_INPUTS};
 use nalgebra::{Matrix3, Vector3};
 
 const L1: f64 = 0.1;
@@ -24,7 +24,7 @@ impl DependentFunction for SliderCrank {
     fn output_count(&self) -> usize {
         2
     }
-    fn eval(&self, x: &[Dual2_64], p: &mut [Dual2_64]) {
+    fn eval(&self, x: &[Jet], p: &mut [Jet]) {
         let alpha = (x[0].sin() * (L1 / L2)).asin();
         p[0] = alpha;
         p[1] = x[0].cos() * L1 + alpha.cos() * L2;
@@ -133,4 +133,28 @@ fn velocities_are_partial_velocities_times_qdot() {
         assert_relative_eq!(v, data.velocity(id), epsilon = 1e-13);
         assert_relative_eq!(w, data.angular_velocity(id), epsilon = 1e-13);
     }
+}
+
+/// A dependent-parameter group takes 1 to MAX_INPUTS inputs: more (or none) is a model error,
+/// not a panic.
+#[test]
+fn dependent_groups_with_too_many_inputs_are_refused() {
+    #[derive(Debug)]
+    struct Sum(usize);
+    impl DependentFunction for Sum {
+        fn input_count(&self) -> usize {
+            self.0
+        }
+        fn output_count(&self) -> usize {
+            1
+        }
+        fn eval(&self, x: &[Jet], p: &mut [Jet]) {
+            p[0] = x.iter().copied().sum();
+        }
+    }
+    let mut b = ModelBuilder::new(8);
+    let inputs: Vec<usize> = (0..=MAX_INPUTS).collect();
+    assert_eq!(b.add_dependent(&inputs, Arc::new(Sum(inputs.len()))), Err(ModelError::DependentInputs { inputs: MAX_INPUTS + 1, max: MAX_INPUTS }));
+    assert_eq!(b.add_dependent(&[], Arc::new(Sum(0))), Err(ModelError::DependentInputs { inputs: 0, max: MAX_INPUTS }));
+    assert_eq!(b.add_dependent(&inputs[..MAX_INPUTS], Arc::new(Sum(MAX_INPUTS))), Ok(0));
 }

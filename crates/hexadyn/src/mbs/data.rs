@@ -1,9 +1,8 @@
 //! The mutable multibody workspace (Model/Data split).
 
 use nalgebra::{Matrix3, Vector3};
-use num_dual::Dual2_64;
 
-use super::dependent::DependentValue;
+use super::dependent::{DependentValue, Jet};
 use super::model::{BodyId, Model};
 use crate::spatial::Htm;
 
@@ -40,7 +39,7 @@ pub struct Data {
     pub(crate) moment: Vec<Vector3<f64>>,
     /// Generalized forces applied directly on the configuration parameters.
     pub(crate) generalized: Vec<f64>,
-    pub(crate) dual_work: Vec<Dual2_64>,
+    pub(crate) dual_work: Vec<Jet>,
     pub(crate) input_work: (Vec<f64>, Vec<f64>),
 }
 

@@ -1,17 +1,29 @@
 //! Dependent parameters (thesis Section 3.3.4, Eq. 3.42-3.50): intermediate variables p(q)
 //! evaluated once per kinematic evaluation, with their exact first and second derivatives.
 
-use num_dual::Dual2_64;
+use nalgebra::{Const, SMatrix, SVector, U1};
+use num_dual::{Derivative, HyperDualSVec64};
 
-/// A group of dependent parameters p = p(x), x a few configuration parameters.
+/// Most inputs a group of dependent parameters can have (a slider-crank has 1, a pantograph 2).
+pub const MAX_INPUTS: usize = 3;
+
+/// The numbers [`DependentFunction`]s are written on: hyper-dual numbers whose first
+/// infinitesimal part carries the gradient over the group's inputs and whose second part the
+/// derivative along the velocity ẋ, so that their product is the Hessian times ẋ. One
+/// evaluation gives p, ∂p/∂x, ṗ = ∂p/∂x ẋ and ẋᵀ (∂²p/∂x²) ẋ.
+pub type Jet = HyperDualSVec64<MAX_INPUTS, 1>;
+
+/// A group of dependent parameters p = p(x), x a few configuration parameters (at most
+/// [`MAX_INPUTS`]).
 ///
-/// Implementations write p(x) once, on second-order dual numbers; the engine obtains the value,
-/// the gradient ∂p/∂x, the rate ṗ = ∂p/∂x ẋ and the convective term ẋᵀ (∂²p/∂x²) ẋ of
-/// p̈ = ∂p/∂x ẍ + ẋᵀ (∂²p/∂x²) ẋ exactly (no numerical differentiation).
+/// Implementations write p(x) once, on [`Jet`]s (best generically over
+/// [`num_dual::DualNum`]); the engine obtains the value, the gradient ∂p/∂x, the rate
+/// ṗ = ∂p/∂x ẋ and the convective term ẋᵀ (∂²p/∂x²) ẋ of p̈ = ∂p/∂x ẍ + ẋᵀ (∂²p/∂x²) ẋ
+/// exactly (no numerical differentiation).
 pub trait DependentFunction: Send + Sync + std::fmt::Debug {
     fn input_count(&self) -> usize;
     fn output_count(&self) -> usize;
-    fn eval(&self, x: &[Dual2_64], p: &mut [Dual2_64]);
+    fn eval(&self, x: &[Jet], p: &mut [Jet]);
 }
 
 /// Value and derivatives of one dependent parameter.
@@ -26,29 +38,24 @@ pub struct DependentValue {
     pub gradient: Vec<f64>,
 }
 
-/// Evaluates a group at (x, ẋ): one pass along ẋ for rate and bias, one pass per input for the
-/// gradient.
-pub(crate) fn evaluate(function: &dyn DependentFunction, x: &[f64], xd: &[f64], out: &mut [DependentValue], work: &mut Vec<Dual2_64>) {
+/// Evaluates a group at (x, ẋ) in one pass: input k seeded with the unit gradient e_k and the
+/// rate ẋ_k.
+pub(crate) fn evaluate(function: &dyn DependentFunction, x: &[f64], xd: &[f64], out: &mut [DependentValue], work: &mut Vec<Jet>) {
     let (ni, no) = (function.input_count(), function.output_count());
     work.clear();
-    work.resize(ni + no, Dual2_64::from_re(0.0));
+    work.resize(ni + no, Jet::from_re(0.0));
     let (xs, ps) = work.split_at_mut(ni);
-    for k in 0..ni {
-        xs[k] = Dual2_64::new(x[k], xd[k], 0.0);
+    for (k, input) in xs.iter_mut().enumerate() {
+        let unit = SVector::<f64, MAX_INPUTS>::from_fn(|r, _| if r == k { 1.0 } else { 0.0 });
+        *input = Jet::new(x[k], Derivative::some(unit), Derivative::some(SMatrix::<f64, 1, 1>::new(xd[k])), Derivative::none());
     }
     function.eval(xs, ps);
     for (o, p) in out.iter_mut().zip(ps.iter()) {
+        let gradient = p.eps1.unwrap_generic(Const::<MAX_INPUTS>, U1);
+        let hessian_xd = p.eps1eps2.unwrap_generic(Const::<MAX_INPUTS>, U1);
         o.value = p.re;
-        o.rate = p.v1;
-        o.bias = p.v2;
-    }
-    for j in 0..ni {
-        for k in 0..ni {
-            xs[k] = Dual2_64::new(x[k], if k == j { 1.0 } else { 0.0 }, 0.0);
-        }
-        function.eval(xs, ps);
-        for (o, p) in out.iter_mut().zip(ps.iter()) {
-            o.gradient[j] = p.v1;
-        }
+        o.rate = p.eps2.unwrap_generic(U1, U1)[0];
+        o.bias = (0..ni).map(|j| hessian_xd[j] * xd[j]).sum();
+        o.gradient.copy_from_slice(&gradient.as_slice()[..ni]);
     }
 }

@@ -16,9 +16,8 @@ mod model;
 mod system;
 
 pub use data::Data;
-pub use dependent::{DependentFunction, DependentValue};
-/// Second-order dual numbers in which [`DependentFunction`]s are written.
-pub use num_dual::{Dual2_64, DualNum};
+pub use dependent::{DependentFunction, DependentValue, Jet, MAX_INPUTS};
+pub use num_dual::DualNum;
 pub use dynamics::{generalized_forces, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, residual};
 pub use kinematics::{kinematics, partial_velocities, partial_velocities_numerical, relative_kinematics};
 pub use model::{BodyId, BodySpec, Elementary, Model, ModelBuilder, ModelError, Var, STANDARD_GRAVITY};

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::dependent::DependentFunction;
+use super::dependent::{DependentFunction, MAX_INPUTS};
 use crate::spatial::{Axis, Htm};
 
 /// Index of a body in its [`Model`].
@@ -117,6 +117,8 @@ pub enum ModelError {
     Coordinate { index: usize, count: usize },
     #[error("dependent parameter index {index} out of range ({count} defined)")]
     Dependent { index: usize, count: usize },
+    #[error("a dependent-parameter group takes 1 to {max} inputs, not {inputs}")]
+    DependentInputs { inputs: usize, max: usize },
 }
 
 #[derive(Clone, Debug)]
@@ -233,6 +235,9 @@ impl ModelBuilder {
     /// Declares a group of dependent parameters computed from the coordinates `inputs`;
     /// returns the index of its first output (use `Var::p(first + k)`).
     pub fn add_dependent(&mut self, inputs: &[usize], function: Arc<dyn DependentFunction>) -> Result<usize, ModelError> {
+        if inputs.is_empty() || inputs.len() > MAX_INPUTS {
+            return Err(ModelError::DependentInputs { inputs: inputs.len(), max: MAX_INPUTS });
+        }
         for &i in inputs {
             if i >= self.coordinates {
                 return Err(ModelError::Coordinate { index: i, count: self.coordinates });

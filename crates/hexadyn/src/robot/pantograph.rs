@@ -7,7 +7,7 @@
 
 use nalgebra::Vector2;
 
-use crate::mbs::{DependentFunction, Dual2_64, DualNum};
+use crate::mbs::{DependentFunction, DualNum, Jet};
 
 /// Lengths of the pantograph (Table 2.1, B.1), in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,7 +68,7 @@ impl DependentFunction for PantographGeometry {
     fn output_count(&self) -> usize {
         2
     }
-    fn eval(&self, x: &[Dual2_64], p: &mut [Dual2_64]) {
+    fn eval(&self, x: &[Jet], p: &mut [Jet]) {
         let (p0, p1) = self.dependent_parameters(x[0], x[1]);
         p[0] = p0;
         p[1] = p1;
