@@ -24,6 +24,14 @@ pub trait DependentFunction: Send + Sync + std::fmt::Debug {
     fn input_count(&self) -> usize;
     fn output_count(&self) -> usize;
     fn eval(&self, x: &[Jet], p: &mut [Jet]);
+
+    /// The same derivatives in closed form, for functions that have it cheaper than the jets:
+    /// fills `out` (value, rate, bias, gradient of each output) at (x, ẋ) and returns true.
+    /// [`Self::eval`] stays the definition, and tests hold the two together
+    /// ([`evaluate_jets`]). The default has no closed form.
+    fn eval_closed_form(&self, _x: &[f64], _xd: &[f64], _out: &mut [DependentValue]) -> bool {
+        false
+    }
 }
 
 /// Value and derivatives of one dependent parameter.
@@ -38,9 +46,16 @@ pub struct DependentValue {
     pub gradient: Vec<f64>,
 }
 
-/// Evaluates a group at (x, ẋ) in one pass: input k seeded with the unit gradient e_k and the
-/// rate ẋ_k.
+/// Evaluates a group at (x, ẋ): in closed form when the function has it, else on jets.
 pub(crate) fn evaluate(function: &dyn DependentFunction, x: &[f64], xd: &[f64], out: &mut [DependentValue], work: &mut Vec<Jet>) {
+    if !function.eval_closed_form(x, xd, out) {
+        evaluate_jets(function, x, xd, out, work);
+    }
+}
+
+/// Evaluates a group at (x, ẋ) in one pass of [`DependentFunction::eval`]: input k seeded with
+/// the unit gradient e_k and the rate ẋ_k.
+pub fn evaluate_jets(function: &dyn DependentFunction, x: &[f64], xd: &[f64], out: &mut [DependentValue], work: &mut Vec<Jet>) {
     let (ni, no) = (function.input_count(), function.output_count());
     work.clear();
     work.resize(ni + no, Jet::from_re(0.0));

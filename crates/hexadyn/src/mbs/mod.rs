@@ -16,7 +16,7 @@ mod model;
 mod system;
 
 pub use data::Data;
-pub use dependent::{DependentFunction, DependentValue, Jet, MAX_INPUTS};
+pub use dependent::{evaluate_jets, DependentFunction, DependentValue, Jet, MAX_INPUTS};
 pub use num_dual::DualNum;
 pub use dynamics::{generalized_forces, kinetic_energy, mass_matrix, nonlinear_effects, potential_energy, residual};
 pub use kinematics::{kinematics, partial_velocities, partial_velocities_numerical, relative_kinematics};

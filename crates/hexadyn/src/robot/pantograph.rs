@@ -7,7 +7,7 @@
 
 use nalgebra::Vector2;
 
-use crate::mbs::{DependentFunction, DualNum, Jet};
+use crate::mbs::{DependentFunction, DependentValue, DualNum, Jet};
 
 /// Lengths of the pantograph (Table 2.1, B.1), in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,6 +73,65 @@ impl DependentFunction for PantographGeometry {
         p[0] = p0;
         p[1] = p1;
     }
+
+    /// [`PantographGeometry::dependent_parameters`] differentiated by hand through k = |AD|:
+    /// p1 = acos(u1(k²)), p0 = acos(u0(k)) − asin(q_v / k).
+    fn eval_closed_form(&self, x: &[f64], xd: &[f64], out: &mut [DependentValue]) -> bool {
+        let (c, l) = (self.c, self.l1);
+        let (v, h, vd, hd) = (x[0], x[1], xd[0], xd[1]);
+        let k2 = Scalar { value: v * v + h * h, gradient: [2.0 * v, 2.0 * h], rate: 2.0 * (v * vd + h * hd), bias: 2.0 * (vd * vd + hd * hd) };
+        let k = k2.then(k2.value.sqrt(), 0.5 / k2.value.sqrt(), -0.25 / (k2.value * k2.value.sqrt()));
+        // u1 = (c² + l² − k²) / (2 l c), linear in k².
+        let u1 = k2.then((c * c + l * l - k2.value) / (2.0 * l * c), -1.0 / (2.0 * l * c), 0.0);
+        // u0 = (k² + c² − l²) / (2 c k) = k / 2c + a / k.
+        let a = (c * c - l * l) / (2.0 * c);
+        let u0 = k.then(k.value / (2.0 * c) + a / k.value, 1.0 / (2.0 * c) - a / (k.value * k.value), 2.0 * a / k.value.powi(3));
+        // w = q_v / k, a product of q_v and 1 / k.
+        let inv_k = k.then(1.0 / k.value, -1.0 / (k.value * k.value), 2.0 / k.value.powi(3));
+        let w = Scalar {
+            value: v * inv_k.value,
+            gradient: [inv_k.value + v * inv_k.gradient[0], v * inv_k.gradient[1]],
+            rate: vd * inv_k.value + v * inv_k.rate,
+            bias: 2.0 * vd * inv_k.rate + v * inv_k.bias,
+        };
+        let p0 = u0.acos().minus(&w.asin());
+        let p1 = u1.acos();
+        for (o, p) in out.iter_mut().zip([p0, p1]) {
+            o.value = p.value;
+            o.rate = p.rate;
+            o.bias = p.bias;
+            o.gradient.copy_from_slice(&p.gradient);
+        }
+        true
+    }
+}
+
+/// A scalar function of (q_v, q_h) with its gradient, its rate along (q̇_v, q̇_h) and the
+/// convective part of its second derivative, ẋᵀ H ẋ.
+#[derive(Clone, Copy, Debug)]
+struct Scalar {
+    value: f64,
+    gradient: [f64; 2],
+    rate: f64,
+    bias: f64,
+}
+
+impl Scalar {
+    /// f(self) from f, f' and f'' at self.value (chain rule: the bias is f'' ṡ² + f' s̈_bias).
+    fn then(&self, value: f64, d1: f64, d2: f64) -> Scalar {
+        Scalar { value, gradient: self.gradient.map(|g| d1 * g), rate: d1 * self.rate, bias: d2 * self.rate * self.rate + d1 * self.bias }
+    }
+    fn acos(&self) -> Scalar {
+        let s = 1.0 - self.value * self.value;
+        self.then(self.value.acos(), -1.0 / s.sqrt(), -self.value / (s * s.sqrt()))
+    }
+    fn asin(&self) -> Scalar {
+        let s = 1.0 - self.value * self.value;
+        self.then(self.value.asin(), 1.0 / s.sqrt(), self.value / (s * s.sqrt()))
+    }
+    fn minus(&self, other: &Scalar) -> Scalar {
+        Scalar { value: self.value - other.value, gradient: [self.gradient[0] - other.gradient[0], self.gradient[1] - other.gradient[1]], rate: self.rate - other.rate, bias: self.bias - other.bias }
+    }
 }
 
 #[cfg(test)]
@@ -94,6 +153,26 @@ mod tests {
             // p1 is the angle between link 0 (B→A) and link 1 (B→D).
             let (_, p1) = AMRU5.dependent_parameters(qv, qh);
             assert_relative_eq!(((a - b).dot(&(d - b)) / (AMRU5.c * AMRU5.l1)).acos(), p1, epsilon = 1e-12);
+        }
+    }
+
+    /// The closed-form derivatives are those of the jets of `eval` (the definition), over the
+    /// joint ranges and at any rates.
+    #[test]
+    fn closed_form_derivatives_match_the_jets() {
+        let fresh = || vec![DependentValue { gradient: vec![0.0; 2], ..Default::default() }; 2];
+        for &(qv, qh, vd, hd) in &[(0.04, 0.005, 1e-3, -2e-3), (0.06, 0.04, -0.01, 0.003), (0.075, 0.055, 0.02, 0.02), (0.05, 0.02, 0.0, 0.0)] {
+            let (mut closed, mut jets) = (fresh(), fresh());
+            assert!(AMRU5.eval_closed_form(&[qv, qh], &[vd, hd], &mut closed));
+            crate::mbs::evaluate_jets(&AMRU5, &[qv, qh], &[vd, hd], &mut jets, &mut Vec::new());
+            for (c, j) in closed.iter().zip(&jets) {
+                assert_relative_eq!(c.value, j.value, epsilon = 1e-14);
+                assert_relative_eq!(c.rate, j.rate, epsilon = 1e-14, max_relative = 1e-12);
+                assert_relative_eq!(c.bias, j.bias, epsilon = 1e-14, max_relative = 1e-12);
+                for (cg, jg) in c.gradient.iter().zip(&j.gradient) {
+                    assert_relative_eq!(*cg, *jg, max_relative = 1e-12);
+                }
+            }
         }
     }
 
