@@ -54,7 +54,8 @@ fn main() {
     let q = model.touching_ground(&joints);
     let qd = vec![0.0; q.len()];
     let start = Instant::now();
-    let mut plant = SimulatedRobot::new(model, &q, &qd, &PlantOptions::from_description(&d)).unwrap();
+    let options = PlantOptions::from_description(&d, &model.options);
+    let mut plant = SimulatedRobot::new(model, &q, &qd, &options).unwrap();
     run(&mut plant, &mut c, 75.0, |_, _, _| {}).unwrap();
     let wall = start.elapsed().as_secs_f64();
     let s = plant.integrator.stats();

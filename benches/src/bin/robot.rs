@@ -38,7 +38,8 @@ fn main() {
             };
             let mut controller = JointPiController { pis, references: JointReferences { base, motions } };
             let start = Instant::now();
-            let mut plant = SimulatedRobot::new(model, &q, &qd, &PlantOptions::from_description(&d)).expect("initial state");
+            let options = PlantOptions::from_description(&d, &model.options);
+            let mut plant = SimulatedRobot::new(model, &q, &qd, &options).expect("initial state");
             run(&mut plant, &mut controller, duration, |_, _, _| {}).expect("simulation");
             let wall = start.elapsed().as_secs_f64();
             let s = plant.integrator.stats();

@@ -37,7 +37,7 @@ fn walk_lifting(lift: f64, friction: FrictionModel, heading: Box<dyn HeadingSour
     let model = Arc::new(RobotModel::new(&d, model_options, Arc::new(FlatGround { height: 0.0 })));
     let q = model.touching_ground(&joints);
     let qd = vec![0.0; q.len()];
-    let mut plant_options = PlantOptions::from_description(&d);
+    let mut plant_options = PlantOptions::from_description(&d, &model.options);
     plant_options.navigation = navigation;
     let plant = SimulatedRobot::new(model, &q, &qd, &plant_options).unwrap();
     let pis = joint_pis(&d, d.controller.period_s);

@@ -521,7 +521,7 @@ fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) ->
     }
 
     // Integrator.
-    let mut plant = PlantOptions::from_description(&robot);
+    let mut plant = PlantOptions::from_description(&robot, &model);
     if let Some(v) = raw.integrator.tolerance {
         c.positive("integrator.tolerance", v).map_err(e)?;
         plant.integrator.tolerance = v;

@@ -349,9 +349,12 @@ impl Newmark {
                 }
                 let contraction = norm / previous;
                 if iteration > 0 && contraction > self.options.slow_contraction && !self.jacobian_fresh {
-                    // Modified Newton is slowing down: refresh the Jacobian and restart the step.
+                    // Modified Newton is slowing down: refresh the Jacobian at this iterate and
+                    // go on from it.
                     self.refresh_jacobian(sys, t_new);
-                    continue 'attempt;
+                    self.factorize(sys, h)?;
+                    previous = f64::INFINITY;
+                    continue;
                 }
                 if contraction > 1.0 && iteration > 1 {
                     break;
