@@ -338,11 +338,6 @@ impl Newmark {
                 if !norm.is_finite() {
                     break;
                 }
-                if std::env::var("HXDBG").is_ok() {
-                    let worst = (0..dx.len()).map(|i| (dx[i].abs() / (test.relative * self.work.qdd[i].abs() + test.floor[i]), i)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
-                    let wn = (0..dx.len()).map(|i| ((dx[i] * test.unit[i] * self.work.weight_q[i]).abs(), i)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
-                    eprintln!("IT t={:.5} h={:.2e} it={} norm/at={:.3e} worst={:.3e}@{} fresh={} wn={}", t_new, h, iteration, norm / test.converge_at, worst.0, sys.layout().names[worst.1], self.jacobian_fresh, sys.layout().names[wn.1]);
-                }
                 if test.converged(norm, &dx, &self.work.qdd) {
                     self.update_kinematics(h);
                     return Ok(self.accept_or_reject(sys, h));
@@ -372,7 +367,6 @@ impl Newmark {
                 continue 'attempt;
             }
             self.stats.rejected_steps += 1;
-            if std::env::var("HXDBG").is_ok() { eprintln!("REJ newton t={} h={:.2e}", self.state.t, h); }
             // This Jacobian belongs to a failed step (possibly evaluated where the residual is not
             // finite): the next attempt evaluates its own rather than inherit a poisoned one.
             self.jacobian = None;
@@ -399,9 +393,6 @@ impl Newmark {
         let ratio = if error > 0.0 { (o.tolerance / error).cbrt() } else { f64::INFINITY };
         if o.adaptive && error > o.tolerance && h > o.h_min * (1.0 + 1e-9) {
             self.stats.rejected_steps += 1;
-            if std::env::var("HXDBG").is_ok() {
-                let wi = (0..n).map(|i| (((self.work.qdd[i] - self.state.qdd[i]) * self.work.weight_q[i]).abs(), i)).fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
-                eprintln!("REJ error t={} h={:.2e} err/tol={:.3} worst={}", self.state.t, h, error / o.tolerance, _sys.layout().names[wi.1]); }
             let h_next = (h * (0.9 * ratio).clamp(0.1, 0.9)).max(o.h_min);
             return StepOutcome::Rejected { h_next };
         }
