@@ -109,10 +109,16 @@ impl Axis {
             Axis::Frame(k) => {
                 // About axis k the columns i = k + 1 and j = k + 2 (cyclic) turn:
                 // c_i' = c c_i + s c_j, c_j' = −s c_i + c c_j (Eq. A.2-A.4).
-                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                let (ci, cj) = (r.column(i).into_owned(), r.column(j).into_owned());
-                r.set_column(i, &(ci * c + cj * s));
-                r.set_column(j, &(cj * c - ci * s));
+                let (i, j) = match k {
+                    0 => (1, 2),
+                    1 => (2, 0),
+                    _ => (0, 1),
+                };
+                for row in 0..3 {
+                    let (a, b) = (r[(row, i)], r[(row, j)]);
+                    r[(row, i)] = c * a + s * b;
+                    r[(row, j)] = c * b - s * a;
+                }
             }
             Axis::General(e) => *r *= rotation_about_sin_cos(e, s, c),
         }
