@@ -4,7 +4,7 @@
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use hexadyn::robot::scenario::{run_scenario_until, Override, Scenario, ScenarioError, SummaryValue};
+use hexadyn::robot::scenario::{run_scenario_until, Override, Record, Scenario, ScenarioError, SummaryValue};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -107,8 +107,8 @@ pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf, overrides: Option<Boun
 /// "scenario" (the scenario TOML text), "robot" (the robot description TOML text),
 /// "robot_source" (`"amru5"` or the robot file). `overrides` maps dotted scenario fields to
 /// values (see `load_scenario`); the returned "scenario" text is then the effective one. With
-/// `timeseries=False` the "columns", "units" and "descriptions" dicts are empty (campaigns that
-/// only need the summary).
+/// `timeseries=False` no time series is built and the "columns", "units" and "descriptions" dicts
+/// are empty (campaigns that only need the summary).
 ///
 /// The simulation runs without the GIL. About every 1 % of the simulated duration (and at the
 /// start and the end) the GIL is taken back to check for signals (Ctrl-C raises
@@ -124,7 +124,8 @@ pub fn run_scenario<'py>(py: Python<'py>, path: PathBuf, progress: Option<Py<PyA
     let mut next_report = 0.0;
     let mut python_error: Option<PyErr> = None;
     let outcome = py.detach(|| {
-        run_scenario_until(&scenario, |t| {
+        let record = if timeseries { Record::TimeSeries } else { Record::SummaryOnly };
+        run_scenario_until(&scenario, record, |t| {
             let last = t >= duration - 0.5 * scenario.period();
             if t < next_report && !last {
                 return ControlFlow::Continue(());
@@ -154,7 +155,7 @@ pub fn run_scenario<'py>(py: Python<'py>, path: PathBuf, progress: Option<Py<PyA
     let columns = PyDict::new(py);
     let units = PyDict::new(py);
     let descriptions = PyDict::new(py);
-    for c in results.series.columns.into_iter().filter(|_| timeseries) {
+    for c in results.series.columns {
         units.set_item(&c.name, c.unit)?;
         descriptions.set_item(&c.name, &c.description)?;
         columns.set_item(&c.name, PyArray1::from_vec(py, c.values))?;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::robot::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Scenario, ScenarioError};
+use hexadyn::robot::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
 use hexadyn::robot::{Joint, AMRU5_TOML};
 
 fn scenarios_dir() -> PathBuf {
@@ -334,7 +334,7 @@ fn unpowered_scenarios_order_the_friction_models() {
 #[test]
 fn progress_can_stop_a_run() {
     let s = short("stand_six_legs", 1.0);
-    let e = run_scenario_until(&s, |t| if t >= 0.095 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }).unwrap_err();
+    let e = run_scenario_until(&s, Record::TimeSeries, |t| if t >= 0.095 { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }).unwrap_err();
     match e {
         ScenarioError::Stopped { t, .. } => assert!((t - 0.1).abs() < 1e-9, "{t}"),
         e => panic!("{e}"),
@@ -492,6 +492,28 @@ fn csv_heading_relative_to_the_scenario() {
     assert_eq!(e.field(), Some("gait.heading"), "{e}");
     assert!(e.to_string().contains("csv heading") && e.to_string().contains("t = 10.00 s"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A run that keeps only its summary builds no time series and sums up the same run: every
+/// summary value but the wall time is bit-identical, the penetration and row count included.
+#[test]
+fn summary_only_runs_sum_up_the_same_run() {
+    let s = short("validation_tripod_1_5cm", 2.0);
+    let full = run_scenario(&s, |_| {}).unwrap();
+    let bare = run_scenario_until(&s, Record::SummaryOnly, |_| ControlFlow::Continue(())).unwrap();
+    assert_eq!(bare.series.len(), 0);
+    assert_eq!(bare.series.columns.len(), 0);
+    assert_eq!(full.summary.rows as usize, full.series.len());
+    let penetration = (0..6).flat_map(|f| full.series.values(&format!("penetration[{f}]")).unwrap().to_vec()).fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(full.summary.max_penetration_m, penetration);
+    assert!(penetration > 0.0, "the feet are in the ground");
+    for ((name, a), (_, b)) in full.summary.entries().into_iter().zip(bare.summary.entries()).filter(|((name, _), _)| *name != "wall_time_s") {
+        let same = match (&a, &b) {
+            (SummaryValue::Number(x), SummaryValue::Number(y)) => x.to_bits() == y.to_bits(),
+            _ => a == b,
+        };
+        assert!(same, "{name}: {a:?} with the time series, {b:?} without");
+    }
 }
 
 /// 5 s of the validation walk: the gait columns are recorded with units, the foot phases go

@@ -872,20 +872,32 @@ impl Summary {
 /// The outcome of [`run_scenario`].
 #[derive(Clone, Debug)]
 pub struct ScenarioResults {
+    /// One row per control instant; empty with [`Record::SummaryOnly`].
     pub series: TimeSeries,
     pub summary: Summary,
 }
 
-/// Runs a scenario; `progress` is called with the simulated time at every control instant.
+/// What a run keeps besides its summary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Record {
+    /// The time series of every control instant (the columns of the module documentation).
+    TimeSeries,
+    /// The summary alone (campaigns of many runs): no time series is built.
+    SummaryOnly,
+}
+
+/// Runs a scenario and records its time series; `progress` is called with the simulated time
+/// at every control instant.
 pub fn run_scenario(s: &Scenario, mut progress: impl FnMut(f64)) -> Result<ScenarioResults> {
-    run_scenario_until(s, |t| {
+    run_scenario_until(s, Record::TimeSeries, |t| {
         progress(t);
         ControlFlow::Continue(())
     })
 }
 
-/// [`run_scenario`] with a `progress` that may stop the run ([`ScenarioError::Stopped`]).
-pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
+/// [`run_scenario`] keeping what `record` says, with a `progress` that may stop the run
+/// ([`ScenarioError::Stopped`]).
+pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
     let started = Instant::now();
     let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
     let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
@@ -936,7 +948,9 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     let mut last_t = 0.0;
     let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
         let state = gait_state.as_ref().map(|g| g.borrow());
-        record_row(&mut rec, p, meas, cmd, lugre, pi, state.as_deref());
+        if record == Record::TimeSeries {
+            record_row(&mut rec, p, meas, cmd, lugre, pi, state.as_deref());
+        }
         stats.observe(p, cmd, supply, pi);
         if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
             let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
@@ -951,7 +965,7 @@ pub fn run_scenario_until(s: &Scenario, mut progress: impl FnMut(f64) -> Control
     }
 
     let series = rec.finish();
-    let mut summary = summarize(s, &plant, &series, &stats, &q, started.elapsed().as_secs_f64());
+    let mut summary = summarize(s, &plant, &stats, &q, started.elapsed().as_secs_f64());
     if let (Some(g), Some(state)) = (&s.gait, &gait_state) {
         summary.gait = Some(GaitSummary::new(g, &gait_stats, &state.borrow().diagnostics));
     }
@@ -968,8 +982,10 @@ pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 
     }
 }
 
-#[derive(Default)]
 struct RunStats {
+    /// Control instants seen.
+    rows: u64,
+    max_penetration: f64,
     commands: u64,
     saturated: u64,
     cuts: u64,
@@ -977,11 +993,19 @@ struct RunStats {
     tracking: [f64; 3],
 }
 
+impl Default for RunStats {
+    fn default() -> Self {
+        RunStats { rows: 0, max_penetration: f64::NEG_INFINITY, commands: 0, saturated: 0, cuts: 0, max_abs_voltage: 0.0, tracking: [0.0; 3] }
+    }
+}
+
 impl RunStats {
     fn observe(&mut self, p: &SimulatedRobot, cmd: &Command, supply: f64, pi: bool) {
         let q = p.state().q.as_slice();
         let out = &p.robot.outputs;
         let model = &p.robot.model;
+        self.rows += 1;
+        self.max_penetration = out.contact.iter().map(|c| c.penetration).fold(self.max_penetration, f64::max);
         for k in 0..JOINTS {
             self.commands += 1;
             if cmd.voltages[k].abs() >= supply {
@@ -999,7 +1023,7 @@ impl RunStats {
     }
 }
 
-fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &RunStats, q0: &[f64], wall: f64) -> Summary {
+fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, q0: &[f64], wall: f64) -> Summary {
     let e = &plant.energy;
     let e0 = &plant.initial_energy;
     let sum = |a: &[f64]| a.iter().sum::<f64>();
@@ -1013,11 +1037,7 @@ fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &
         + sum(&e.friction_work).abs()
         + sum(&e.contact_work).abs()
         + (e.magnetic_energy - e0.magnetic_energy).abs();
-    let max_penetration = (0..6)
-        .filter_map(|f| series.values(&format!("penetration[{f}]")))
-        .flat_map(|v| v.iter().copied())
-        .fold(f64::NEG_INFINITY, f64::max);
-    let rows = series.len() as u64;
+    let rows = stats.rows;
     Summary {
         scenario: s.name.clone(),
         friction: s.model.friction.name(),
@@ -1051,7 +1071,7 @@ fn summarize(s: &Scenario, plant: &SimulatedRobot, series: &TimeSeries, stats: &
         saturated_fraction: if stats.commands > 0 { stats.saturated as f64 / stats.commands as f64 } else { 0.0 },
         limit_switch_cuts: stats.cuts,
         max_tracking_error: matches!(s.control, ControlMode::Pi | ControlMode::Gait).then_some(stats.tracking),
-        max_penetration_m: max_penetration,
+        max_penetration_m: stats.max_penetration,
         gait: None,
     }
 }
