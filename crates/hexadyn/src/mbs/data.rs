@@ -12,6 +12,8 @@ use crate::spatial::Htm;
 pub struct Data {
     /// T_{0,i} (Eq. 3.23).
     pub(crate) pose: Vec<Htm>,
+    /// Central inertia tensors in the global frame, R Φ Rᵀ.
+    pub(crate) world_inertia: Vec<Matrix3<f64>>,
     /// ω_i and v_i in the global frame (Eq. 3.26, 3.33).
     pub(crate) omega: Vec<Vector3<f64>>,
     pub(crate) velocity: Vec<Vector3<f64>>,
@@ -55,6 +57,7 @@ impl Data {
         }
         Data {
             pose: vec![Htm::identity(); nb],
+            world_inertia: vec![Matrix3::zeros(); nb],
             omega: vec![z; nb],
             velocity: vec![z; nb],
             alpha_bias: vec![z; nb],

@@ -1,16 +1,10 @@
 //! Equations of motion by the virtual power principle (thesis Eq. 3.37-3.41):
 //! M(q) q̈ + h(q, q̇) = g(q, q̇, t).
 
-use nalgebra::{DMatrix, Matrix3, Vector3};
+use nalgebra::{DMatrix, Vector3};
 
 use super::data::Data;
 use super::model::Model;
-
-/// Central inertia tensor of body i in the global frame, {Φ_Gi}_0 = R Φ Rᵀ.
-fn world_inertia(model: &Model, data: &Data, i: usize) -> Matrix3<f64> {
-    let r = &data.pose[i].rotation;
-    r * model.bodies[i].inertia * r.transpose()
-}
 
 /// Residual f = M q̈ + h − g of the multibody rows (Eq. 3.37, 3.38) written into `f[..n]`,
 /// without forming M: f_j = Σ_i d_ij·(m_i a_i − R_i) + δ_ij·(Φ_i ω̇_i + ω_i × Φ_i ω_i − M_i) − Q_j.
@@ -43,7 +37,7 @@ pub fn residual(model: &Model, data: &mut Data, qdd: &[f64], f: &mut [f64]) {
     data.subtree.iter_mut().for_each(|w| *w = (Vector3::zeros(), Vector3::zeros()));
     for (i, body) in model.bodies.iter().enumerate().rev() {
         let (a, alpha) = data.qdd_acceleration[i];
-        let phi = world_inertia(model, data, i);
+        let phi = data.world_inertia[i];
         let w = data.omega[i];
         let lin = (data.accel_bias[i] + a - model.gravity) * body.mass - data.force[i];
         let ang = phi * (data.alpha_bias[i] + alpha) + w.cross(&(phi * w)) - data.moment[i];
@@ -72,7 +66,7 @@ pub fn mass_matrix(model: &Model, data: &Data, m: &mut DMatrix<f64>) {
         let cols = &body.columns;
         let d = &data.d[body.offset..body.offset + cols.len()];
         let delta = &data.delta[body.offset..body.offset + cols.len()];
-        let phi = world_inertia(model, data, i);
+        let phi = data.world_inertia[i];
         for (k, &ck) in cols.iter().enumerate() {
             let md = d[k] * body.mass;
             let pd = phi * delta[k];
@@ -94,7 +88,7 @@ pub fn nonlinear_effects(model: &Model, data: &Data) -> Vec<f64> {
     data.assert_complete();
     let mut h = vec![0.0; model.coordinates];
     for (i, body) in model.bodies.iter().enumerate() {
-        let phi = world_inertia(model, data, i);
+        let phi = data.world_inertia[i];
         let w = data.omega[i];
         let lin = data.accel_bias[i] * body.mass;
         let ang = phi * data.alpha_bias[i] + w.cross(&(phi * w));
@@ -127,7 +121,7 @@ pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
         .enumerate()
         .map(|(i, b)| {
             let w = data.omega[i];
-            0.5 * (b.mass * data.velocity[i].norm_squared() + w.dot(&(world_inertia(model, data, i) * w)))
+            0.5 * (b.mass * data.velocity[i].norm_squared() + w.dot(&(data.world_inertia[i] * w)))
         })
         .sum()
 }

@@ -8,7 +8,7 @@
 //! partial velocities ride along rigidly, so they are kept relative to it (and summed into the
 //! full d_ij, δ_ij only when asked for, e.g. for the mass matrix).
 
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::data::Data;
 use super::dependent;
@@ -62,6 +62,19 @@ fn offset_motion(r: &Vector3<f64>, omega: &Vector3<f64>, alpha: &Vector3<f64>, v
 pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
     relative_kinematics(model, data, q, qd);
     partial_velocities(model, data);
+}
+
+/// Central inertia tensor in the global frame {Φ_G}_0 = R Φ Rᵀ (Eq. 3.38); with principal
+/// moments φ_k along the body axes, Σ_k φ_k r_k r_kᵀ over the columns r_k of R.
+fn world_inertia(r: &Matrix3<f64>, inertia: &Matrix3<f64>, principal: Option<&Vector3<f64>>) -> Matrix3<f64> {
+    match principal {
+        Some(phi) => {
+            let entry = |a: usize, b: usize| phi.x * r[(a, 0)] * r[(b, 0)] + phi.y * r[(a, 1)] * r[(b, 1)] + phi.z * r[(a, 2)] * r[(b, 2)];
+            let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
+            Matrix3::new(entry(0, 0), xy, xz, xy, entry(1, 1), yz, xz, yz, entry(2, 2))
+        }
+        None => r * inertia * r.transpose(),
+    }
 }
 
 /// Evaluates dependent parameters, then poses, velocities and convective accelerations of all
@@ -127,6 +140,7 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
                 }
             }
         }
+        data.world_inertia[i] = world_inertia(&pose.rotation, &body.inertia, body.principal.as_ref());
         data.pose[i] = pose;
         data.omega[i] = omega;
         data.velocity[i] = vel;
@@ -195,4 +209,21 @@ pub fn partial_velocities_numerical(model: &Model, data: &mut Data, q: &[f64]) -
     }
     kinematics(model, data, q, &zero);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spatial::yaw_pitch_roll;
+
+    /// The principal-moment form of R Φ Rᵀ is the product.
+    #[test]
+    fn world_inertia_from_principal_moments_is_the_product() {
+        let r = yaw_pitch_roll(0.7, -0.4, 1.9);
+        let phi = Vector3::new(0.3, 1.2, 2.5);
+        let inertia = Matrix3::from_diagonal(&phi);
+        let product = r * inertia * r.transpose();
+        assert!((world_inertia(&r, &inertia, Some(&phi)) - product).amax() < 1e-15 * product.amax());
+        assert_eq!(world_inertia(&r, &inertia, None), product);
+    }
 }

@@ -154,6 +154,8 @@ pub(crate) struct Body {
     pub joint: Vec<CompiledElementary>,
     pub mass: f64,
     pub inertia: Matrix3<f64>,
+    /// The diagonal of `inertia` when the body axes are its principal axes (the usual case).
+    pub principal: Option<Vector3<f64>>,
     /// Sorted configuration parameters this body's motion depends on (its non-zero columns of
     /// J_S and J_ω).
     pub columns: Vec<usize>,
@@ -338,6 +340,7 @@ impl ModelBuilder {
                 joint,
                 mass: spec.mass,
                 inertia: spec.inertia,
+                principal: (spec.inertia == Matrix3::from_diagonal(&spec.inertia.diagonal())).then(|| spec.inertia.diagonal()),
                 columns,
                 parent_columns,
                 offset,
