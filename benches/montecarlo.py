@@ -7,6 +7,7 @@ factor, the ratio against the thesis' cost (260 s of computation per 75 s simula
 and the parallel speed-up over the baseline.
 
     .venv/bin/python benches/montecarlo.py --runs 50          # or: make bench-montecarlo MC_ARGS="--runs 50"
+    make bench-montecarlo MC_ARGS="--runs 1000 --variants dry_viscous"   # the 4000-walk campaign
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--runs", type=int, default=None, help="runs per velocity (default: the robot's, 1000)")
+    parser.add_argument("--variants", default=None, help="comma-separated friction variants (default: both, dry_viscous,dry_viscous_load)")
     parser.add_argument("--baseline-runs", type=int, default=1, help="runs per velocity of the single-worker baseline (default 1)")
     parser.add_argument("--workers", type=int, default=os.cpu_count(), help="parallel workers (default: every core)")
     parser.add_argument("--out", type=Path, default=None, help="keep the campaign in this new folder (default: a temporary one)")
@@ -48,8 +50,9 @@ def main() -> None:
     if args.out is not None and args.out.exists():
         sys.exit(f"{args.out}: exists; the benchmark needs a new folder (an existing campaign would be resumed, not timed)")
 
-    campaign = Campaign.create(args.scenario, runs_per_velocity=args.runs)
-    baseline = Campaign.create(args.scenario, runs_per_velocity=args.baseline_runs)
+    variants = None if args.variants is None else [v.strip() for v in args.variants.split(",")]
+    campaign = Campaign.create(args.scenario, runs_per_velocity=args.runs, variants=variants)
+    baseline = Campaign.create(args.scenario, runs_per_velocity=args.baseline_runs, variants=variants)
     with tempfile.TemporaryDirectory(prefix="hexadyn-bench-mc-") as tmp:
         print(f"baseline: {len(baseline.keys())} simulations on 1 worker ...", flush=True)
         _, b_wall, _, _, b_n = timed_campaign(baseline, Path(tmp) / "baseline", 1, progress=False)
