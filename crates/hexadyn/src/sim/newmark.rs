@@ -170,8 +170,8 @@ impl Newmark {
     /// between control instants) and refreshed only when the iteration with it does not contract
     /// fast: modified Newton, as in the steps.
     pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
-        let start = self.state.qdd.clone();
         if self.mass_lu.is_some() {
+            let start = self.state.qdd.clone();
             if self.consistent_accelerations(sys, FAST_CONTRACTION)? {
                 return Ok(());
             }
