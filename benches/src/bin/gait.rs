@@ -10,11 +10,12 @@ use std::time::Instant;
 use hexadyn::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitOptions};
 use hexadyn::control::gait::heading::{Constant, Heading};
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
-use hexadyn::control::{joint_pis, Controller, LegKinematics, Measurements, JOINTS};
+use hexadyn::control::{joint_pis, Controller, Measurements};
+use hexadyn::hexapod::{LegKinematics, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::RobotDescription;
+use hexadyn::description::RobotDescription;
 use nalgebra::Vector3;
 
 const THESIS_WALL_S: f64 = 260.0;

@@ -6,11 +6,12 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use hexadyn::control::{joint_pis, JointMotion, JointPiController, JointReferences, JOINTS};
+use hexadyn::control::{joint_pis, JointMotion, JointPiController, JointReferences};
+use hexadyn::hexapod::JOINTS;
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::RobotDescription;
+use hexadyn::description::RobotDescription;
 
 const THESIS_REAL_TIME_FACTOR: f64 = 75.0 / 260.0;
 

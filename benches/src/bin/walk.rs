@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use hexadyn::robot::scenario::{run_scenario, Scenario};
+use hexadyn::scenario::{run_scenario, Scenario};
 
 const THESIS_WALL_S: f64 = 260.0;
 const THESIS_SIMULATED_S: f64 = 75.0;

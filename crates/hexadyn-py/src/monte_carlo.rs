@@ -2,8 +2,9 @@
 //! of Section 6.5 (Table 6.7, and Table 5.5 for the load coefficients) read from a robot
 //! description, keyed by the scenario fields they are written to (`[model.joint_friction]`).
 
-use hexadyn::robot::scenario::DEFAULT_ROBOT;
-use hexadyn::robot::{Gaussian, Joint, RobotDescription};
+use hexadyn::scenario::DEFAULT_ROBOT;
+use hexadyn::description::{Gaussian, RobotDescription};
+use hexadyn::hexapod::Joint;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;

@@ -4,7 +4,7 @@
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use hexadyn::robot::scenario::{run_scenario_until, Override, Record, Scenario, ScenarioError, SummaryValue};
+use hexadyn::scenario::{run_scenario_until, Override, Record, Scenario, ScenarioError, SummaryValue};
 use numpy::PyArray1;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;

@@ -1,7 +1,7 @@
 //! Runs a scenario file and prints its summary (the engine alone, without Python):
 //! `cargo run --release -p hexadyn --example scenario -- python/hexadyn/scenarios/stand_six_legs.toml`
 
-use hexadyn::robot::scenario::{run_scenario, Scenario, SummaryValue};
+use hexadyn::scenario::{run_scenario, Scenario, SummaryValue};
 
 fn main() {
     let Some(path) = std::env::args().nth(1) else {

@@ -2,7 +2,8 @@
 //! the error messages for each kind of bad input (file, field path, value, allowed range).
 
 mod robot {
-    use hexadyn::robot::{DescriptionError, Joint, RobotDescription, AMRU5_TOML};
+    use hexadyn::description::{DescriptionError, RobotDescription, AMRU5_TOML};
+    use hexadyn::hexapod::Joint;
     use std::path::PathBuf;
 
     fn shipped_path() -> PathBuf {

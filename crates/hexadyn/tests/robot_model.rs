@@ -5,8 +5,9 @@ use std::sync::Arc;
 
 use approx::assert_relative_eq;
 use hexadyn::physics::FlatGround;
-use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, Robot, RobotModel, JOINTS};
-use hexadyn::robot::RobotDescription;
+use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, Robot, RobotModel};
+use hexadyn::hexapod::JOINTS;
+use hexadyn::description::RobotDescription;
 use hexadyn::sim::{finite_difference_jacobian, static_equilibrium, Jacobian, Newmark, NewmarkOptions, StaticOptions, System};
 
 /// q_v of the supporting legs and of the lifted ones, q_h of all (m).

@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::robot::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
-use hexadyn::robot::{Joint, AMRU5_TOML};
+use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
+use hexadyn::description::AMRU5_TOML;
+use hexadyn::hexapod::Joint;
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios")
@@ -677,7 +678,7 @@ fn walking_energy_closes_and_orders_the_friction_models() {
         let s = overridden(&[Override::new("model.friction", friction), Override::new("model.load_dependence", load), Override::new("scenario.duration_s", 12.0)]).unwrap();
         run_scenario(&s, |_| {}).unwrap().summary
     };
-    let xi = |s: &hexadyn::robot::scenario::Summary| {
+    let xi = |s: &hexadyn::scenario::Summary| {
         let e = s.energy_electrical_j;
         assert!(s.energy_balance_error_relative.abs() < 0.01 && s.energy_balance_error_j.abs() < 0.01 * e, "{}: imbalance {} J of {e} J", s.friction, s.energy_balance_error_j);
         assert!((s.energy_electrical_by_joint_j.iter().sum::<f64>() - e).abs() < 1e-9 * e.abs());

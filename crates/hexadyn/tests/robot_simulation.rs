@@ -3,11 +3,13 @@
 
 use std::sync::Arc;
 
-use hexadyn::control::{joint_pis, DigitalPi, JointMotion, JointPiController, JointReferences, ReferenceFeed, JOINTS};
+use hexadyn::control::{joint_pis, DigitalPi, JointMotion, JointPiController, JointReferences, ReferenceFeed};
+use hexadyn::hexapod::JOINTS;
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::{Joint, RobotDescription};
+use hexadyn::description::RobotDescription;
+use hexadyn::hexapod::Joint;
 
 fn model(friction: FrictionModel, tweak: impl FnOnce(&mut ModelOptions)) -> Arc<RobotModel> {
     let d = RobotDescription::amru5();

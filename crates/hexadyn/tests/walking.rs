@@ -6,11 +6,12 @@ use hexadyn::control::gait::controller::{joints_at_workspace_centres, AepMode, G
 use hexadyn::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Spline};
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::control::gait::pattern::{FootCycle, GaitPattern};
-use hexadyn::control::{joint_pis, Controller, LegKinematics, Measurements, Plant, JOINTS};
+use hexadyn::control::{joint_pis, Controller, Measurements, Plant};
+use hexadyn::hexapod::{LegKinematics, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::robot::RobotDescription;
+use hexadyn::description::RobotDescription;
 use nalgebra::Vector3;
 
 struct Walk {

@@ -43,9 +43,10 @@ use nalgebra::Matrix3;
 
 use super::pi_design::{JointPlant, PiDesign};
 use crate::physics::FlatGround;
-use crate::robot::mechanics::{joint_index, DOF};
-use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel, JOINTS};
-use crate::robot::{Joint, RobotDescription};
+use crate::hexapod::{joint_index, DOF};
+use crate::description::RobotDescription;
+use crate::hexapod::{Joint, JOINTS};
+use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel};
 use crate::sim::{linearize, System};
 
 /// Neutral leg configuration of Section 4.4.1 where J is read: (q_r, q_v, q_h) = (0, 0.06, 0.04)

@@ -6,8 +6,7 @@
 
 use nalgebra::Vector3;
 
-/// Number of actuated joints of a hexapod with 3-DOF legs.
-pub const JOINTS: usize = 18;
+use crate::hexapod::JOINTS;
 
 /// Body pose from a navigation system (Section 7.4), yaw-pitch-roll as in Eq. 3.52.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

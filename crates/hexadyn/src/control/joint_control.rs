@@ -2,9 +2,10 @@
 
 use std::f64::consts::TAU;
 
-use super::interface::{Command, Controller, Measurements, JOINTS};
+use super::interface::{Command, Controller, Measurements};
 use super::DigitalPi;
-use crate::robot::{Joint, RobotDescription};
+use crate::description::RobotDescription;
+use crate::hexapod::{Joint, JOINTS};
 
 /// The 18 digital PI of a robot (gains K, T_i of its description, Table 4.1 for AMRU5) at the
 /// control period `dt`, joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).

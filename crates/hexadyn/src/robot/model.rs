@@ -16,9 +16,8 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Vector3};
 
-use super::description::RobotDescription;
-use super::mechanics::{joint_index, Mechanics, MechanicsParameters, DOF};
-use super::Joint;
+use crate::description::RobotDescription;
+use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Terrain};
 use crate::physics::{DryViscous, FrictionElement, JointFriction, LoadDependence, LuGre, SteadyState};
@@ -26,7 +25,6 @@ use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
 
-pub use crate::control::JOINTS;
 
 /// Error scale of a bristle deflection z (Eq. 3.85) as a fraction of its steady-state value
 /// while sliding ([`LuGre::sliding_deflection`]): z carries the friction torque σ0 z, so its

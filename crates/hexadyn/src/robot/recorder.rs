@@ -4,7 +4,7 @@
 //! unit, description); every later row must put the same columns in the same order, which
 //! [`Recorder::end_row`] checks. The names follow the thesis symbols with the joint or foot
 //! index in brackets: `q_v[2]`, `i_q_v[2]`, `tau_f_q_v[2]`, `Fz[2]` (see
-//! [`crate::robot::scenario`] for the full list).
+//! [`crate::scenario`] for the full list).
 
 use std::fmt;
 

@@ -6,8 +6,9 @@ use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use super::model::{FrictionModel, ModelOptions, Robot, RobotModel};
-use super::RobotDescription;
-use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant, JOINTS};
+use crate::description::RobotDescription;
+use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant};
+use crate::hexapod::JOINTS;
 use crate::mbs;
 use crate::physics::JointFriction;
 use crate::sim::{Newmark, NewmarkOptions, SimError, State};

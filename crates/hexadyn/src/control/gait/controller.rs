@@ -11,7 +11,8 @@ use nalgebra::Vector3;
 use super::body_motion::{BodyMotion, Pose};
 use super::heading::HeadingSource;
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
-use crate::control::{Command, Controller, DigitalPi, LegKinematics, Measurements, Workspace, JOINTS};
+use crate::control::{Command, Controller, DigitalPi, Measurements};
+use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
 /// How the AEP is found during the swing (Section 7.5).

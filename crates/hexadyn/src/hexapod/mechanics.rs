@@ -8,6 +8,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::pantograph::PantographGeometry;
+use super::{joint_index, DOF};
 use crate::spatial::Htm;
 use crate::mbs::{BodyId, BodySpec, Elementary, Model, ModelBuilder, ModelError, Var};
 
@@ -73,14 +74,6 @@ pub struct Mechanics {
     /// Foot F in the frame of link 3 (the leg).
     pub foot_local: Vector3<f64>,
     pub parameters: MechanicsParameters,
-}
-
-/// Number of configuration parameters: (X, Y, Z, Φ, Θ, Ψ) then (q_r, q_v, q_h) per leg (Eq. 3.51).
-pub const DOF: usize = 24;
-
-/// Index of coordinate `joint` (0 = q_r, 1 = q_v, 2 = q_h) of `leg` in q.
-pub const fn joint_index(leg: usize, joint: usize) -> usize {
-    6 + 3 * leg + joint
 }
 
 impl Mechanics {
@@ -179,46 +172,12 @@ impl Mechanics {
     }
 }
 
-impl MechanicsParameters {
-    /// The mechanics of a robot description (SI units). Interpretations of the lost figures
-    /// (NOTES.md), kept here in one place:
-    /// - the q_r axis O_l lies at the height of the body centre of mass, at R_rot along the leg
-    ///   direction;
-    /// - the centre of gravity of link 0 lies at L_G0 from A along the link, that of the leg
-    ///   (link 3) at x_G_leg from C; links 1 and 2 have theirs at mid-length;
-    /// - all three rotors ride on the leg chassis (Eq. 3.69-3.71), the q_r rotor at L_x6 from
-    ///   the body centre along the leg direction.
-    pub fn from_description(d: &super::RobotDescription) -> Self {
-        let g = &d.geometry;
-        let pg = &g.pantograph;
-        let inertia = |b: &super::description::RigidBody| Inertia { mass: b.mass_kg, moments: Vector3::from(b.principal_moments()) };
-        let i = &d.inertia;
-        MechanicsParameters {
-            pantograph: PantographGeometry { l0: pg.l_0_m, l1: pg.l_1_m, l2: pg.l_2_m, l3: pg.l_3_m, c: pg.c_m },
-            leg_angles: d.leg_angles_rad(),
-            r_rot: g.body.r_rot_m,
-            chassis_cog: Vector3::new(g.chassis.l_x1_m, g.chassis.l_y1_m, g.chassis.l_z1_m),
-            crossing_point: Vector3::new(g.chassis.l_xc_m, g.chassis.l_yc_m, g.chassis.l_zc_m),
-            link_cog: [pg.l_g0_m, pg.l_1_m / 2.0, pg.l_2_m / 2.0, pg.x_g_leg_m],
-            rotor_r_radius: g.actuators.l_x6_m,
-            rotor_v: Vector3::new(g.actuators.l_x7_m, g.actuators.l_y7_m, g.actuators.l_z7_m),
-            rotor_h: Vector3::new(g.actuators.l_x8_m, g.actuators.l_y8_m, g.actuators.l_z8_m),
-            reductions: [d.reductions.n_r, d.reductions.n_v_rad_per_m, d.reductions.n_h_rad_per_m],
-            body: inertia(&i.main_body),
-            chassis: inertia(&i.chassis),
-            links: [inertia(&i.pantograph_upper), inertia(&i.pantograph_left), inertia(&i.pantograph_lower), inertia(&i.pantograph_leg)],
-            rotor_mass: i.rotor.mass_kg,
-            rotor_axial: i.rotor.i_axial_kg_m2,
-            rotor_equatorial: i.rotor.i_equatorial_kg_m2,
-        }
-    }
-}
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mbs::{kinematics, mass_matrix, Data};
-    use crate::robot::RobotDescription;
+    use crate::description::RobotDescription;
     use crate::spatial::{rotation_about, Htm};
     use approx::assert_relative_eq;
     use nalgebra::DMatrix;

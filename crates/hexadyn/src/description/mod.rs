@@ -12,6 +12,15 @@
 //! ([`RobotDescription::friction`]). All friction values of Chapters 5-6 are joint-side
 //! already; [`RobotDescription::joint_torque_per_ampere`] gives the k_t n factor of Eq. 5.17
 //! for converting motor currents.
+//!
+//! ```
+//! use hexadyn::description::RobotDescription;
+//! use hexadyn::hexapod::Joint;
+//! let robot = RobotDescription::amru5();
+//! assert_eq!(robot.legs.len(), 6);
+//! let f = robot.friction(0, Joint::Vertical);
+//! assert!(f.tau_f_d_plus > 0.0 && f.tau_f_d_minus < 0.0);
+//! ```
 
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -22,16 +31,15 @@ use std::path::Path;
 use serde::de::{self, Deserializer, Visitor};
 use serde::Deserialize;
 
-use super::Joint;
+use crate::hexapod::{Joint, LEG_COUNT};
+
+mod hexapod_parameters;
 
 /// The shipped AMRU5 description (`robots/amru5.toml`), embedded at compile time.
 pub const AMRU5_TOML: &str = include_str!("../../../../robots/amru5.toml");
 
 /// Name used in error messages for the embedded file.
 const AMRU5_ORIGIN: &str = "robots/amru5.toml";
-
-/// Number of legs of a hexapod; every per-leg array has this length.
-pub const LEG_COUNT: usize = 6;
 
 // =============================================================================================
 // Errors
@@ -868,7 +876,7 @@ impl RobotDescription {
 
 /// Byte spans of every key and value of the document, to turn serde errors and validation
 /// paths into dotted field paths and line numbers. Shared with the scenario loader
-/// (`robot::scenario`), which reports errors the same way.
+/// (`crate::scenario`), which reports errors the same way.
 pub(crate) struct SpanIndex<'t> {
     file: String,
     text: &'t str,

@@ -117,18 +117,18 @@ use std::time::Instant;
 
 use serde::Deserialize;
 
-use super::description::{Ctx, DescriptionError, FieldError, SpanIndex, AMRU5_TOML};
-use super::model::{FrictionModel, ModelOptions, Robot, RobotModel};
-use super::recorder::{Recorder, TimeSeries};
-use super::simulation::{run_until, PlantOptions, SimulatedRobot};
-use super::{Joint, RobotDescription};
+use crate::description::{Ctx, DescriptionError, FieldError, RobotDescription, SpanIndex, AMRU5_TOML};
+use crate::hexapod::{Joint, JOINTS};
+use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel};
+use crate::robot::recorder::{Recorder, TimeSeries};
+use crate::robot::simulation::{run_until, PlantOptions, SimulatedRobot};
 
 mod gait;
 mod joint_friction;
 mod overrides;
 pub use overrides::Override;
 pub use gait::{phase_code, GaitChange, GaitScenario, GaitSummary, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
-use crate::control::{joint_pis, Command, Controller, JointMotion, JointPiController, JointReferences, Measurements, Unpowered, JOINTS};
+use crate::control::{joint_pis, Command, Controller, JointMotion, JointPiController, JointReferences, Measurements, Unpowered};
 use crate::physics::FlatGround;
 use crate::sim::{static_equilibrium, SimError, StaticOptions};
 
@@ -136,7 +136,7 @@ use crate::sim::{static_equilibrium, SimError, StaticOptions};
 pub const DEFAULT_ROBOT: &str = "amru5";
 
 /// Where "missing field" errors send the reader.
-const REFERENCE: &str = "the module docs of hexadyn::robot::scenario or the shipped scenarios";
+const REFERENCE: &str = "the module docs of hexadyn::scenario or the shipped scenarios";
 
 /// Relative tolerance on stroke checks (a sawtooth written to the printed stroke ends passes).
 const STROKE_TOLERANCE: f64 = 1e-6;

@@ -7,7 +7,7 @@
 //! overrides), so a results folder always holds the scenario that actually ran.
 
 use super::{ScenarioError, REFERENCE};
-use crate::robot::description::{FieldError, SpanIndex};
+use crate::description::{FieldError, SpanIndex};
 
 /// One field set from outside the scenario file.
 #[derive(Clone, Debug, PartialEq)]

@@ -48,9 +48,10 @@ use crate::control::gait::body_motion::Pose;
 use crate::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitDiagnostics, GaitOptions};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
-use crate::control::{joint_pis, Command, Controller, LegKinematics, Measurements, Workspace, JOINTS};
-use crate::robot::description::{Ctx, DescriptionError};
-use crate::robot::RobotDescription;
+use crate::control::{joint_pis, Command, Controller, Measurements};
+use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::description::{Ctx, DescriptionError};
+use crate::description::RobotDescription;
 
 type Result<T> = std::result::Result<T, DescriptionError>;
 

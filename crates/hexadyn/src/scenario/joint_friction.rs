@@ -20,8 +20,9 @@
 
 use serde::Deserialize;
 
-use crate::robot::description::{Ctx, DescriptionError, Measured, PerLeg};
-use crate::robot::{Joint, RobotDescription};
+use crate::description::{Ctx, DescriptionError, Measured, PerLeg};
+use crate::description::RobotDescription;
+use crate::hexapod::Joint;
 
 /// The raw `[model.joint_friction]` table.
 #[derive(Deserialize, Default)]
