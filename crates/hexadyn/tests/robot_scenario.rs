@@ -370,15 +370,19 @@ fn walking_scenarios_parse() {
         HeadingSpec::Constant(h) => assert_eq!((h.velocity.x, h.velocity.y, h.yaw_rate), (0.015, 0.0, 0.0)),
         h => panic!("{h:?}"),
     }
-    // The default body height: q_v = 0.06 m (about 0.414 m); the legs start at their workspace
-    // centres, which the joints reach.
+    // The default body height: q_v = 0.06 m (about 0.414 m); the legs start where the steady
+    // gait has them (issue 18): legs 0, 3, 4 begin their support 2Δφ T = 1.2 s after their
+    // AEP, V_x ((β + 4Δφ)/2 − 2Δφ) T = 0.015 x 3 s = 4.5 cm ahead of their workspace centres;
+    // legs 1, 2, 5 are 0.1 T before their PEP, 4.5 cm behind.
     assert!((g.body_height - 0.414).abs() < 1e-3, "{}", g.body_height);
     assert_eq!(s.initial.joints, g.joints);
     assert!(s.initial.settle && s.initial.lifted_legs.is_empty());
     for l in 0..6 {
         let q = nalgebra::Vector3::new(g.joints[3 * l], g.joints[3 * l + 1], g.joints[3 * l + 2]);
-        let foot = g.legs[l].foot(&q);
-        assert!((foot - g.workspaces[l].centre_at(-g.body_height)).norm() < 1e-6, "leg {l}");
+        let foot = g.legs[l].foot_in_body(&q);
+        let ahead = if [0, 3, 4].contains(&l) { 0.045 } else { -0.045 };
+        let expected = g.legs[l].to_body(&g.workspaces[l].centre_at(-g.body_height)) + nalgebra::Vector3::new(ahead, 0.0, 0.0);
+        assert!((foot - expected).norm() < 1e-6, "leg {l}: {foot:?} instead of {expected:?}");
     }
     assert!(!s.plant.navigation);
 
@@ -585,6 +589,30 @@ fn gait_runs_record_the_walk_deterministically() {
         assert!(names.contains(&n), "{n} missing from the summary");
     }
     assert_eq!(a.summary.control, "gait");
+}
+
+/// Issue 18: every shipped walk respects its workspaces from the first step: no foot
+/// reference clamped by the inverse kinematics, none more than 1 µm outside its workspace
+/// cylinder (the encoders' quantization of the start posture is below that).
+#[test]
+fn every_shipped_walk_keeps_its_feet_in_the_workspaces() {
+    let mut walks: Vec<PathBuf> = std::fs::read_dir(scenarios_dir()).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
+    walks.sort();
+    let walks: Vec<Scenario> = walks.iter().map(|p| Scenario::from_file(p).unwrap()).filter(|s| s.gait.is_some()).collect();
+    assert!(walks.len() >= 14, "{} shipped walks", walks.len());
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|scope| {
+        for chunk in walks.chunks(walks.len().div_ceil(threads)) {
+            scope.spawn(move || {
+                for s in chunk {
+                    let run = run_scenario_until(s, Record::SummaryOnly, |_| ControlFlow::Continue(())).unwrap();
+                    let g = run.summary.gait.as_ref().expect("gait summary");
+                    assert_eq!(g.clamped_ik_references, 0, "{}: {g:?}", s.name);
+                    assert!(g.max_foot_reference_outside_workspace_m <= 1e-6, "{}: {g:?}", s.name);
+                }
+            });
+        }
+    });
 }
 
 /// A gait change requested at 1 s is made once all six feet are down (the tripod's double

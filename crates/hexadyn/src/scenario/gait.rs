@@ -45,7 +45,7 @@ use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::control::gait::body_motion::Pose;
-use crate::control::gait::controller::{joints_at_workspace_centres, AepMode, GaitController, GaitDiagnostics, GaitOptions};
+use crate::control::gait::controller::{joints_at, steady_footholds, AepMode, GaitController, GaitDiagnostics, GaitOptions};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
 use crate::control::{joint_pis, Command, Controller, Measurements};
@@ -339,9 +339,6 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
         }
     }
     let workspaces: [Workspace; 6] = workspaces.try_into().expect("six legs");
-    let joints = joints_at_workspace_centres(&legs, &workspaces, height)
-        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its workspace centre"), reach.clone()))?;
-
     let heading = validate_heading(&g.heading, c, dir)?;
 
     // Strokes: every support stroke, |v_C| x support time, fits the workspace diameter.
@@ -382,6 +379,9 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
     }
 
     let options = GaitOptions { period: g.period_s, pattern, cycle, aep: g.aep, lift: clearance, dt };
+    let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading.source().heading(0.0));
+    let joints = joints_at(&legs, &footholds)
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.clone()))?;
     Ok(GaitScenario { options, heading, navigation: g.navigation, body_height: height, legs, workspaces, changes, joints })
 }
 

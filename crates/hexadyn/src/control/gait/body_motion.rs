@@ -63,13 +63,6 @@ impl BodyMotion {
         self.pose
     }
 
-    /// Global velocity of a point rigidly attached to the body at `p_body` (body frame):
-    /// v_C = v_b + ω × p_{C/b} (Eq. 7.25).
-    pub fn point_velocity(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
-        let r = self.pose.htm().rotation * p_body;
-        self.velocity + self.omega.cross(&r)
-    }
-
     pub fn velocity(&self) -> Vector3<f64> {
         self.velocity
     }

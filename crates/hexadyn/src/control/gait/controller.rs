@@ -9,7 +9,7 @@
 use nalgebra::Vector3;
 
 use super::body_motion::{BodyMotion, Pose};
-use super::heading::HeadingSource;
+use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
 use crate::control::{Command, Controller, DigitalPi, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
@@ -50,9 +50,10 @@ struct Leg {
     anchor: Vector3<f64>,
     /// Horizontal foot reference in the leg frame during the swing.
     swing_xy: Vector3<f64>,
-    /// Start of the current swing (leg frame) and its AEP, for the periodic mode.
+    /// Start of the current swing (leg frame), its AEP and its duration, for the periodic mode.
     swing_from: Vector3<f64>,
     aep: Vector3<f64>,
+    swing_time: f64,
     /// Current foot reference (leg frame) and joint references.
     foot: Vector3<f64>,
     joints: Vector3<f64>,
@@ -86,7 +87,7 @@ pub struct GaitController {
 
 impl GaitController {
     pub fn new(options: GaitOptions, legs: [LegKinematics; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
-        let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), foot: Vector3::zeros(), joints: Vector3::zeros() };
+        let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), swing_time: 0.0, foot: Vector3::zeros(), joints: Vector3::zeros() };
         GaitController { options, legs_kinematics: legs, workspaces, pis, heading, body: None, legs: [idle; 6], origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
     }
 
@@ -125,7 +126,9 @@ impl GaitController {
     }
 
     /// First update: the body pose (navigation, or the feet on flat ground at z = 0) and the
-    /// anchors of the six feet from the measured joints.
+    /// anchors of the six feet from the measured joints, on one support level (their mean
+    /// height: the ground is flat, and the encoders' quantization must not give each foot a
+    /// support level of its own).
     fn start(&mut self, m: &Measurements) {
         let feet: Vec<Vector3<f64>> = (0..6).map(|l| self.legs_kinematics[l].foot_in_body(&joints_of(m, l))).collect();
         let pose = m.pose.map_or_else(
@@ -139,6 +142,10 @@ impl GaitController {
             self.legs[l].foot = foot;
             self.legs[l].joints = q;
             self.legs[l].anchor = self.leg_frame(l, &htm).apply(&foot);
+        }
+        let level = self.legs.iter().map(|l| l.anchor.z).sum::<f64>() / 6.0;
+        for leg in &mut self.legs {
+            leg.anchor.z = level;
         }
         self.body = Some(BodyMotion::new(pose));
         self.origin = m.t;
@@ -172,12 +179,12 @@ impl GaitController {
 
     /// AEP in the leg frame (Eq. 7.24 / 7.30): the workspace centre C moved by the velocity of C
     /// over half the support.
-    fn aep(&self, leg: usize, frame: &Htm, body: &BodyMotion, z: f64) -> Vector3<f64> {
+    fn aep(&self, leg: usize, frame: &Htm, body: &BodyMotion, heading: &Heading, z: f64) -> Vector3<f64> {
         let o = &self.options;
         let c_leg = self.workspaces[leg].centre_at(z);
         let c_body = self.legs_kinematics[leg].to_body(&c_leg);
         // Eq. 7.25, expressed in the leg frame.
-        let v_c = frame.rotation.transpose() * body.point_velocity(&c_body);
+        let v_c = frame.rotation.transpose() * heading.point_velocity(&(body.pose.htm().rotation * c_body));
         let mut aep = c_leg + v_c * (o.cycle.support_fraction(self.current_pattern().beta) * o.period / 2.0);
         aep.z = z;
         aep
@@ -213,19 +220,55 @@ impl GaitController {
     }
 }
 
-/// The walking start posture: the joints that put every foot at the centre of its workspace on
-/// the ground `height` below the body (leg frame z = −height), found by Eq. 7.7 from the
-/// neutral posture. The error is the first leg that cannot reach its centre.
-pub fn joints_at_workspace_centres(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64) -> Result<[f64; JOINTS], usize> {
+/// The joints that put every foot at its foothold (leg frames), found by Eq. 7.7 from the
+/// neutral posture. The error is the first leg that cannot reach its foothold.
+pub fn joints_at(legs: &[LegKinematics; 6], footholds: &[Vector3<f64>; 6]) -> Result<[f64; JOINTS], usize> {
     let neutral = Vector3::new(0.0, 0.06, 0.03);
     let mut joints = [0.0; JOINTS];
     for l in 0..6 {
-        match legs[l].inverse(&workspaces[l].centre_at(-height), &neutral) {
+        match legs[l].inverse(&footholds[l], &neutral) {
             Ok(ik) if ik.is_reached() => joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice()),
             _ => return Err(l),
         }
     }
     Ok(joints)
+}
+
+/// The standing posture: every foot at the centre of its workspace on the ground `height` below
+/// the body (leg frame z = −height).
+pub fn joints_at_workspace_centres(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64) -> Result<[f64; JOINTS], usize> {
+    joints_at(legs, &std::array::from_fn(|l| workspaces[l].centre_at(-height)))
+}
+
+/// The walking start posture: each foot on the ground `height` below the body where the steady
+/// gait of `options` under the heading `start` would have it at the leg's initial phase, so that
+/// the first support stroke is centred on the workspace centre C like every later one.
+///
+/// INTERPRETATION: the thesis starts from the workspace centres and notes that "during the
+/// first step, the stroke is not centered in the workspace" (Section 7.5.1); from a centre, the
+/// first support stroke |v_C| (β + 4Δφ) T runs from C to a full stroke behind it and leaves the
+/// workspace as soon as the stroke exceeds its radius (2.5 cm/s with T = 12 s). Here a foot
+/// whose phase is e T into its motion with the body, which begins at the AEP (the landing's
+/// start, φ = 1 − 2Δφ, or φ = 0 for the plain cycle) and lasts the support fraction s
+/// (Eq. 7.24, 7.30), stands at AEP − v_C e T = C + v_C (s/2 − e) T; a foot whose phase is a
+/// fraction u into its swing stands where the steady swing would carry it, PEP + u (AEP − PEP) =
+/// C + v_C s T (u − 1/2), and swings to its AEP in the rest of the swing. Every AEP is the
+/// steady one, so the walk from the first swing on is the steady walk.
+pub fn steady_footholds(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64, options: &GaitOptions, start: &Heading) -> [Vector3<f64>; 6] {
+    let beta = options.pattern.beta;
+    let cycle = options.cycle;
+    let support = cycle.support_fraction(beta);
+    let moving_from = cycle.swing_start(beta) + cycle.swing_fraction(beta);
+    std::array::from_fn(|l| {
+        let centre = workspaces[l].centre_at(-height);
+        let elapsed = (options.pattern.phase(l, 0.0, options.period) - moving_from).rem_euclid(1.0);
+        // Eq. 7.25 at the start (yaw 0: the global and body frames coincide), in the leg frame.
+        let v_c = legs[l].direction_to_leg(&start.point_velocity(&legs[l].to_body(&centre)));
+        let behind_aep = if elapsed < support { elapsed } else { support * (1.0 - (elapsed - support) / (1.0 - support)) };
+        let mut foot = centre + v_c * ((support / 2.0 - behind_aep) * options.period);
+        foot.z = -height;
+        foot
+    })
 }
 
 fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
@@ -234,11 +277,11 @@ fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
 
 impl Controller for GaitController {
     fn update(&mut self, m: &Measurements) -> Command {
+        let h = self.heading.heading(m.t);
         if self.body.is_none() {
             self.start(m);
         } else {
             // Eq. 7.12-7.23: the desired body HTM from the heading velocities.
-            let h = self.heading.heading(m.t);
             let dt = self.options.dt;
             self.body.as_mut().expect("started").step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), dt);
         }
@@ -268,11 +311,15 @@ impl Controller for GaitController {
             let mut next = leg;
             next.phase = target;
             match (leg.phase, target) {
-                // Entering the swing: start from the current horizontal reference.
+                // Entering the swing: start from the current horizontal reference. A swing entered
+                // late (a walk that starts with the leg's phase in the swing) has only the rest of
+                // the swing to reach its AEP.
                 (FootPhase::Support | FootPhase::Takeoff, FootPhase::Swing) => {
                     next.swing_from = Vector3::new(leg.foot.x, leg.foot.y, support_foot.z);
                     next.swing_xy = next.swing_from;
-                    next.aep = self.aep(l, &frame_desired, &body, support_foot.z);
+                    next.aep = self.aep(l, &frame_desired, &body, &h, support_foot.z);
+                    let late = (phi - o.cycle.swing_start(beta)) * o.period;
+                    next.swing_time = if late < o.dt { swing_time } else { ((o.cycle.swing_start(beta) + o.cycle.swing_fraction(beta) - phi) * o.period).max(o.dt) };
                 }
                 // Landing: the virtual AEP of Section 7.6 where the foot reference is, seen with
                 // the estimated body pose, so that the support algorithm runs during the landing.
@@ -302,10 +349,10 @@ impl Controller for GaitController {
                     let remaining = ((o.cycle.swing_start(beta) + o.cycle.swing_fraction(beta) - phi) * o.period).max(o.dt);
                     let velocity = match o.aep {
                         // Eq. 7.26 / 7.31.
-                        AepMode::Periodic => (next.aep - next.swing_from) / swing_time,
+                        AepMode::Periodic => (next.aep - next.swing_from) / next.swing_time,
                         // Eq. 7.29 with the saturation at twice the steady swing velocity.
                         AepMode::Omnidirectional => {
-                            let aep = self.aep(l, &frame_desired, &body, support_foot.z);
+                            let aep = self.aep(l, &frame_desired, &body, &h, support_foot.z);
                             next.aep = aep;
                             let v = (aep - next.swing_xy) / remaining;
                             let steady = 2.0 * (aep - self.workspaces[l].centre_at(aep.z)).norm() / swing_time;
@@ -334,5 +381,63 @@ impl Controller for GaitController {
         }
         let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
         Command { voltages, references }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::gait::heading::Constant;
+    use crate::control::joint_pis;
+    use crate::description::RobotDescription;
+    use crate::test_util::rng;
+    use rand::Rng;
+
+    /// Issue 18: from the steady footholds, no foot reference leaves its workspace and none is
+    /// clamped by the inverse kinematics, for random constant headings whose support stroke
+    /// fits the workspace (the scenario check: (|v| + |Ω_z| r_C) (β + 4Δφ) T <= 2 R), for the
+    /// three patterns and both foot cycles. The plant is ideal: the joints are their references.
+    #[test]
+    fn a_walk_from_the_steady_footholds_never_leaves_the_workspace() {
+        let d = RobotDescription::amru5();
+        let legs = LegKinematics::hexapod_from_description(&d).unwrap();
+        let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
+        let lift = 0.045;
+        let workspaces: [Workspace; 6] = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
+        let dt = d.controller.period_s;
+        let mut r = rng(18);
+        for case in 0..120 {
+            let pattern = match case % 3 {
+                0 => GaitPattern::tripod(),
+                1 => GaitPattern::wave(r.random_range(0.5..0.75)),
+                _ => GaitPattern::equal_phase(r.random_range(0.5..0.75)),
+            };
+            let cycle = if case % 2 == 0 { FootCycle::Enhanced { overlap: 0.05 } } else { FootCycle::Plain };
+            let period = r.random_range(6.0..15.0);
+            let support = cycle.support_fraction(pattern.beta) * period;
+            let direction = r.random_range(0.0..std::f64::consts::TAU);
+            let turning = r.random_range(-1.0f64..1.0) * 0.02;
+            let arm = (0..6).map(|l| legs[l].to_body(&workspaces[l].centre_at(-height)).xy().norm()).fold(0.0, f64::max);
+            let radius = workspaces[0].radius;
+            // The fastest speed whose stroke fits, and a random fraction of it.
+            let speed = ((2.0 * radius / support - turning.abs() * arm) * r.random_range(0.3..1.0)).max(0.0);
+            let heading = Heading::new(speed * direction.cos(), speed * direction.sin(), turning);
+            let options = GaitOptions { period, pattern, cycle, aep: AepMode::Periodic, lift, dt };
+            let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading);
+            let joints = joints_at(&legs, &footholds).unwrap();
+            let mut controller = GaitController::new(options, legs.clone(), workspaces, joint_pis(&d, dt), Box::new(Constant(heading)));
+            let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None };
+            let mut outside = 0.0f64;
+            for k in 0..(2.0 * period / dt).round() as usize {
+                m.t = k as f64 * dt;
+                let command = controller.update(&m);
+                for (l, foot) in controller.foot_references().iter().enumerate() {
+                    outside = outside.max(workspaces[l].distance_outside(foot));
+                }
+                m.positions = command.references;
+            }
+            assert_eq!(controller.diagnostics.clamped_references, 0, "case {case}: {heading:?}, T = {period}, {:?}", controller.diagnostics);
+            assert!(outside < 1e-9, "case {case}: a foot reference {outside} m outside its workspace ({heading:?}, T = {period})");
+        }
     }
 }

@@ -16,6 +16,12 @@ impl Heading {
     pub fn new(vx: f64, vy: f64, yaw_rate: f64) -> Self {
         Heading { velocity: Vector3::new(vx, vy, 0.0), yaw_rate }
     }
+
+    /// Commanded global velocity of a point rigidly attached to the body at `r` from its centre
+    /// (global frame): v_C = v_b + ω × p_{C/b} (Eq. 7.25) with ω = (0, 0, Ω_z).
+    pub fn point_velocity(&self, r: &Vector3<f64>) -> Vector3<f64> {
+        self.velocity + Vector3::new(0.0, 0.0, self.yaw_rate).cross(r)
+    }
 }
 
 /// Where the heading velocities come from.
