@@ -6,8 +6,15 @@ The numerics live in the Rust engine (``hexadyn._core``); this package is the us
     results = hexadyn.simulate("stand_six_legs")     # a shipped scenario or a scenario file
     results.timeseries["Z"]                          # pandas DataFrame indexed by t (s)
     results.units["Z"], results.summary["body_height_change_m"]
-    results.save("results/stand")                    # atomic; hexadyn.Results.load(folder)
     hexadyn.list_scenarios()                         # the shipped scenario files
+
+    from hexadyn import report                       # the results folder with tables and plots
+    report.save(results, "results/stand")            # atomic; hexadyn.Results.load(folder)
+
+The modules build on each other in one direction, each importing only modules listed before
+it: ``vocabulary``, ``tomltext``, ``atomic`` (column names, TOML texts, atomic writes),
+``results`` (the data), ``energy`` (the power analysis), ``plots`` (figures), ``report`` (the
+results folder), ``runner`` (:func:`simulate`), then ``compare``, ``montecarlo`` and ``cli``.
 """
 
 from __future__ import annotations

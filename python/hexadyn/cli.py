@@ -109,7 +109,7 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
     gets the time series, the summary, the power and energy tables (power.csv, energy.csv) and,
     unless --no-plots, the figures in plots/ (see `hexadyn plot`).
     """
-    from hexadyn import _core
+    from hexadyn import _core, report
 
     path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
     # Validate before anything is created: a bad scenario leaves no results folder behind.
@@ -119,7 +119,7 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
     results = hexadyn.simulate(path, progress=not no_progress)
-    results.save(out, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
+    report.save(results, out, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
     s = results.summary
     click.echo(f"Results: {out}")
     click.echo(f"  scenario    {info['name']} ({path})")
@@ -169,8 +169,10 @@ def _echo_power(results: hexadyn.Results) -> None:
 @with_plot_options
 def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     """(Re)generate the figures of the results FOLDER into FOLDER/plots/ (replaced atomically)."""
+    from hexadyn import report
+
     results = hexadyn.Results.load(folder)
-    figures = results.plot(folder / "plots", legs=legs, formats=formats)
+    figures = report.plot(results, folder / "plots", legs=legs, formats=formats)
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
 
 

@@ -34,8 +34,11 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hexadyn import energy, plots
-from hexadyn.results import parse_toml, write_csv, write_folder
+from hexadyn import atomic, energy, plots
+from hexadyn.report import write_csv
+from hexadyn.runner import resolve_scenario, simulate
+from hexadyn.tomltext import parse_toml
+from hexadyn.vocabulary import JOINT_TYPES, LEGS
 
 #: Friction models of the comparison: name -> scenario overrides (Section 6.1 and 6.4.4).
 MODELS: dict[str, dict[str, Any]] = {
@@ -108,10 +111,8 @@ def _validate(scenario: Path, runs: Sequence[tuple[str, float]]) -> None:
 
 def _run(scenario: str, model: str, velocity: float) -> dict[str, Any]:
     """One run (in a worker process): its averaged power table and robot figures."""
-    import hexadyn
-
     try:
-        results = hexadyn.simulate(scenario, progress=False, overrides=_overrides(Path(scenario), model, velocity))
+        results = simulate(scenario, progress=False, overrides=_overrides(Path(scenario), model, velocity))
     except ValueError as exc:
         raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
     s = results.summary
@@ -152,9 +153,7 @@ def compare_friction(
     Raises ValueError naming the model, the velocity and the field for a run the scenario
     cannot take (e.g. a velocity whose stride does not fit the workspace).
     """
-    import hexadyn
-
-    path = hexadyn.resolve_scenario(scenario)
+    path = resolve_scenario(scenario)
     velocities = _check_velocities(velocities)
     unknown = [m for m in models if m not in MODELS]
     if unknown or not models:
@@ -224,7 +223,7 @@ def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: l
         r = robot.xs(m, level="model")
         alpha, beta = energy.fit_power_velocity(r.index.to_numpy(), r["average_power_w"].to_numpy())
         mass = float(r["mass_kg"].iloc[0])
-        fit_rows[m] = {"alpha_w": alpha, "beta_n": beta, "xi_asymptote": beta / (mass * energy.G), "mass_kg": mass}
+        fit_rows[m] = {"alpha_w": alpha, "beta_n": beta, "xi_asymptote": energy.specific_resistance_asymptote(beta, mass), "mass_kg": mass}
     fit = pd.DataFrame.from_dict(fit_rows, orient="index").rename_axis("model")
     table_velocity = own_velocity if own_velocity in velocities else velocities[0]
     return Comparison(name, power, robot, fit, table_velocity)
@@ -235,7 +234,7 @@ def joint_tables(comparison: Comparison, velocity: float | None = None) -> dict[
     and friction model (columns), at `velocity` (default: the comparison's table velocity)."""
     v = comparison.table_velocity if velocity is None else velocity
     at = comparison.power.xs(v, level="velocity_m_s")
-    return {j: at[j].unstack("model")[list(at.index.unique("model"))].rename_axis(index="leg", columns=None) for j in energy.JOINT_TYPES}
+    return {j: at[j].unstack("model")[list(at.index.unique("model"))].rename_axis(index="leg", columns=None) for j in JOINT_TYPES}
 
 
 def figures(comparison: Comparison) -> dict[str, Figure]:
@@ -266,15 +265,15 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
         fig = Figure(figsize=(6.3, 6.0))
         axes = fig.subplots(3, 1, sharex=True)
         width = 0.8 / len(models)
-        x = np.arange(len(energy.LEGS))
+        x = np.arange(len(LEGS))
         for ax, (joint, table) in zip(axes, tables.items()):
             for k, m in enumerate(models):
-                ax.bar(x - 0.4 + width * (k + 0.5), table[m].loc[list(energy.LEGS)].to_numpy(), width, color=MODEL_COLOURS[m], label=f"{MODEL_LABELS[m]} ({table.loc[energy.TOTAL, m]:.3g} W)")
+                ax.bar(x - 0.4 + width * (k + 0.5), table[m].loc[list(LEGS)].to_numpy(), width, color=MODEL_COLOURS[m], label=f"{MODEL_LABELS[m]} ({table.loc[energy.TOTAL, m]:.3g} W)")
             ax.set_ylim(top=ax.get_ylim()[1] * 1.4)  # room for the legend
             ax.legend(loc="upper left", title="model (total)", ncol=2, frameon=False)
             ax.set_ylabel(f"${joint}$ power [W]")
             ax.grid(axis="x", visible=False)
-        axes[-1].set_xticks(x, [f"leg {leg}" for leg in energy.LEGS])
+        axes[-1].set_xticks(x, [f"leg {leg}" for leg in LEGS])
         fig.suptitle(f"{comparison.scenario}: averaged power per actuator, $V_x$ = {comparison.table_velocity * 100:g} cm/s (Tables 6.3-6.6)")
         out["power_by_model"] = fig
     return out
@@ -283,8 +282,8 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
 def save(comparison: Comparison, folder: str | os.PathLike, *, overwrite: bool = False, formats: Sequence[str] = plots.DEFAULT_FORMATS) -> Path:
     """Writes the tables and figures of a comparison into `folder`, atomically."""
     target = Path(folder)
-    if target.exists() and not overwrite:
-        raise FileExistsError(17, "the comparison folder exists (choose another folder or overwrite it)", str(target))
+    if not overwrite:
+        atomic.refuse_existing(target, "comparison folder")
     figs = figures(comparison)
 
     def write(tmp: Path) -> None:
@@ -294,5 +293,5 @@ def save(comparison: Comparison, folder: str | os.PathLike, *, overwrite: bool =
         (tmp / "plots").mkdir()
         plots.save_figures(figs, tmp / "plots", formats)
 
-    write_folder(target, write)
+    atomic.write_folder(target, write)
     return target

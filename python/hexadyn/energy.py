@@ -35,21 +35,13 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 import pandas as pd
 
-from hexadyn._core import STANDARD_GRAVITY
-from hexadyn.results import parse_toml
+from hexadyn import _core
+from hexadyn.tomltext import parse_toml
+from hexadyn.vocabulary import ACTUATORS, JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
 
-#: Gravity g (m/s²) of Eq. 6.6: the engine's multibody gravity (``mbs::STANDARD_GRAVITY``).
-G = STANDARD_GRAVITY
-
-#: Joint types in the order of the thesis tables: rotation, vertical, horizontal.
-JOINT_TYPES = ("q_r", "q_v", "q_h")
-LEGS = tuple(range(6))
-
-#: Foot phase codes of the ``phase[l]`` columns.
-SUPPORT, TAKEOFF, SWING, LANDING = 0, 1, 2, 3
 #: Phase groups of the power tables: name -> phase codes. Transitions are takeoff and landing.
 PHASE_GROUPS: dict[str, tuple[int, ...]] = {"support": (SUPPORT,), "swing": (SWING,), "transitions": (TAKEOFF, LANDING)}
 #: Name of the whole-run group in the power tables.
@@ -57,11 +49,10 @@ ALL = "all"
 TOTAL = "total"
 
 __all__ = [
-    "G",
-    "JOINT_TYPES",
-    "LEGS",
+    "ALL",
     "PHASE_GROUPS",
-    "actuator",
+    "TOTAL",
+    "add_energy_figures",
     "averaged_power",
     "energy_breakdown",
     "energy_figures",
@@ -71,17 +62,14 @@ __all__ = [
     "robot_mass",
     "sampled_power",
     "specific_resistance",
+    "specific_resistance_asymptote",
     "specific_resistance_fit",
 ]
 
 
-def actuator(joint: str, leg: int) -> str:
-    """Name of an actuator, as in the column names: ``actuator("q_v", 2) == "q_v[2]"``."""
-    return f"{joint}[{leg}]"
-
-
-def _actuators() -> list[str]:
-    return [actuator(j, leg) for leg in LEGS for j in JOINT_TYPES]
+def _columns(quantity: str) -> list[str]:
+    """The columns of an actuator quantity for every actuator: ``E_el_q_r[0]``, ..."""
+    return [actuator_column(quantity, a) for a in ACTUATORS]
 
 
 def _require(frame: pd.DataFrame, columns: Sequence[str], what: str) -> None:
@@ -110,12 +98,11 @@ def power(results: Results) -> pd.DataFrame:
     energy of each actuator.
     """
     ts = results.timeseries
-    names = _actuators()
-    _require(ts, [f"E_el_{a}" for a in names], "the power")
+    columns = _columns("E_el")
+    _require(ts, columns, "the power")
     dt = _period(ts.index)
-    e_el = ts[[f"E_el_{a}" for a in names]].to_numpy()
-    p = np.diff(e_el, axis=0) / dt
-    return pd.DataFrame(p, index=ts.index[1:], columns=names)
+    p = np.diff(ts[columns].to_numpy(), axis=0) / dt
+    return pd.DataFrame(p, index=ts.index[1:], columns=list(ACTUATORS))
 
 
 def sampled_power(results: Results) -> pd.DataFrame:
@@ -125,11 +112,10 @@ def sampled_power(results: Results) -> pd.DataFrame:
     period); Σ u_k i_k Δt approximates E_el to the variation of the current within a period.
     """
     ts = results.timeseries
-    names = _actuators()
-    _require(ts, [f"{p}_{a}" for a in names for p in ("u", "i")], "the sampled power")
-    u = ts[[f"u_{a}" for a in names]].to_numpy()
-    i = ts[[f"i_{a}" for a in names]].to_numpy()
-    return pd.DataFrame((u * i)[1:], index=ts.index[1:], columns=names)
+    _require(ts, _columns("u") + _columns("i"), "the sampled power")
+    u = ts[_columns("u")].to_numpy()
+    i = ts[_columns("i")].to_numpy()
+    return pd.DataFrame((u * i)[1:], index=ts.index[1:], columns=list(ACTUATORS))
 
 
 def foot_phases(results: Results) -> pd.DataFrame | None:
@@ -139,7 +125,7 @@ def foot_phases(results: Results) -> pd.DataFrame | None:
     commanded the period's voltage (``phase[l]`` of the previous row, see the module doc).
     """
     ts = results.timeseries
-    columns = [f"phase[{leg}]" for leg in LEGS]
+    columns = [leg_column("phase", leg) for leg in LEGS]
     if not all(c in ts.columns for c in columns):
         return None
     codes = ts[columns].to_numpy()[:-1].round().astype(int)
@@ -178,18 +164,20 @@ def averaged_power(results: Results) -> pd.DataFrame:
     return table
 
 
-def _magnetic_energy_change(results: Results, names: Sequence[str]) -> np.ndarray:
-    """Δ(½ L i²) per actuator (J), non-zero only if the scenario models the inductance."""
+def _robot_properties(results: Results) -> dict[str, float]:
+    """Mass and motor inductance of the robot description stored with the results, as the
+    engine reads it (``_core.robot_properties``)."""
+    return _core.robot_properties(results.metadata.get("robot", ""), "the robot description stored with these results")
+
+
+def _magnetic_energy_change(results: Results) -> np.ndarray:
+    """Δ(½ L i²) per actuator (J), non-zero only if the scenario models the inductance
+    (``[model] inductance = true``, Eq. 3.91)."""
     scenario = parse_toml(results.metadata.get("scenario", ""), "the scenario stored with these results")
     if not scenario.get("model", {}).get("inductance", False):
-        return np.zeros(len(names))
-    robot = parse_toml(results.metadata.get("robot", ""), "the robot description stored with these results")
-    try:
-        inductance = float(robot["motor"]["inductance_mh"]) * 1e-3
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ValueError(f"the robot description of these results has no valid motor.inductance_mh ({exc})") from None
-    ts = results.timeseries
-    i = ts[[f"i_{a}" for a in names]].to_numpy()
+        return np.zeros(len(ACTUATORS))
+    inductance = _robot_properties(results)["inductance_h"]
+    i = results.timeseries[_columns("i")].to_numpy()
     return 0.5 * inductance * (i[-1] ** 2 - i[0] ** 2)
 
 
@@ -203,17 +191,16 @@ def energy_breakdown(results: Results) -> pd.DataFrame:
     mechanism then drives the motor (e.g. a vertical joint lowering the body).
     """
     ts = results.timeseries
-    names = _actuators()
     kinds = {"electrical_j": "E_el", "joule_j": "E_joule", "friction_j": "E_fric"}
-    _require(ts, [f"{c}_{a}" for c in kinds.values() for a in names], "the energy breakdown")
+    _require(ts, [c for quantity in kinds.values() for c in _columns(quantity)], "the energy breakdown")
     first, last = ts.iloc[0], ts.iloc[-1]
-    table = pd.DataFrame(index=pd.Index(names, name="actuator"))
+    table = pd.DataFrame(index=pd.Index(ACTUATORS, name="actuator"))
     table["leg"] = [leg for leg in LEGS for _ in JOINT_TYPES]
     table["joint"] = list(JOINT_TYPES) * len(LEGS)
-    for key, prefix in kinds.items():
-        cols = [f"{prefix}_{a}" for a in names]
+    for key, quantity in kinds.items():
+        cols = _columns(quantity)
         table[key] = last[cols].to_numpy() - first[cols].to_numpy()
-    table["magnetic_j"] = _magnetic_energy_change(results, names)
+    table["magnetic_j"] = _magnetic_energy_change(results)
     table["mechanical_j"] = table["electrical_j"] - table["joule_j"] - table["friction_j"] - table["magnetic_j"]
     return table
 
@@ -221,23 +208,22 @@ def energy_breakdown(results: Results) -> pd.DataFrame:
 def robot_mass(results: Results) -> float:
     """The robot mass m (kg) of Eq. 6.6.
 
-    ``robot_mass_kg`` of the summary when the engine reports it, otherwise
-    ``inertia.total_mass_kg`` of the robot description the results were computed with.
+    ``robot_mass_kg`` of the summary when the engine reports it (m_0 + 6 m_leg), otherwise
+    the total mass stated in the robot description the results were computed with
+    (``inertia.total_mass_kg``, Table B.2, as the engine reads it): the m of results saved
+    before the engine reported its mass.
     """
     if "robot_mass_kg" in results.summary:
         return float(results.summary["robot_mass_kg"])
-    robot = parse_toml(results.metadata.get("robot", ""), "the robot description stored with these results")
     try:
-        mass = float(robot["inertia"]["total_mass_kg"])
-    except (KeyError, TypeError, ValueError):
-        raise ValueError("the robot description of these results has no inertia.total_mass_kg, and the summary no robot_mass_kg") from None
-    if not mass > 0:
-        raise ValueError(f"robot description: field `inertia.total_mass_kg` = {mass}: allowed: a positive mass (kg)")
-    return mass
+        return _robot_properties(results)["stated_mass_kg"]
+    except ValueError as exc:
+        raise ValueError(f"the summary of these results has no robot_mass_kg, and their robot description gives no inertia.total_mass_kg: {exc}") from None
 
 
 def specific_resistance(energy_j: float, mass_kg: float, distance_m: float) -> float:
-    """Specific resistance ξ = E / (m g l), Eq. 6.6 (dimensionless).
+    """Specific resistance ξ = E / (m g l), Eq. 6.6 (dimensionless): the engine's formula
+    (``_core.specific_resistance``, that of the summary's ``specific_resistance``).
 
     Args:
         energy_j: total energy E expended, e.g. the electrical energy of Eq. 6.7 (J).
@@ -248,7 +234,7 @@ def specific_resistance(energy_j: float, mass_kg: float, distance_m: float) -> f
         raise ValueError(f"specific resistance: mass = {mass_kg} kg; allowed: > 0")
     if not distance_m > 0:
         raise ValueError(f"specific resistance: distance = {distance_m} m; allowed: > 0 (the robot must travel)")
-    return energy_j / (mass_kg * G * distance_m)
+    return _core.specific_resistance(energy_j, mass_kg, distance_m)
 
 
 def fit_power_velocity(velocity_m_s: Sequence[float], power_w: Sequence[float]) -> tuple[float, float]:
@@ -271,14 +257,21 @@ def fit_power_velocity(velocity_m_s: Sequence[float], power_w: Sequence[float]) 
 
 
 def specific_resistance_fit(alpha_w: float, beta_n: float, mass_kg: float, velocity_m_s: Any) -> Any:
-    """ξ(V) = α / (m g V) + β / (m g), Eq. 6.11, for a velocity or an array of velocities (m/s)."""
-    if not mass_kg > 0:
-        raise ValueError(f"specific resistance: mass = {mass_kg} kg; allowed: > 0")
+    """ξ(V) = α / (m g V) + β / (m g), Eq. 6.11, for a velocity or an array of velocities (m/s).
+
+    That is Eq. 6.6 for the power P = α + β V of Eq. 6.8: the energy P T over the distance V T.
+    """
     v = np.asarray(velocity_m_s, dtype=float)
     if (v <= 0).any():
         raise ValueError("specific resistance: velocities must be positive")
-    xi = alpha_w / (mass_kg * G * v) + beta_n / (mass_kg * G)
+    xi = np.vectorize(lambda x: specific_resistance(alpha_w + beta_n * x, mass_kg, x), otypes=[float])(v)
     return float(xi) if xi.ndim == 0 else xi
+
+
+def specific_resistance_asymptote(beta_n: float, mass_kg: float) -> float:
+    """ξ(V → ∞) = β / (m g) of Eq. 6.11: Eq. 6.6 for the propulsion force β alone, whose work
+    over a distance l is β l."""
+    return specific_resistance(beta_n, mass_kg, 1.0)
 
 
 def energy_figures(results: Results) -> dict[str, float]:
@@ -288,7 +281,7 @@ def energy_figures(results: Results) -> dict[str, float]:
     (Σ of the breakdown's mechanical work), ``friction_share`` (friction work over the
     electrical energy, Σ E_fric / Σ E_el), ``joule_share``, ``robot_mass_kg`` (the m used, see
     :func:`robot_mass`) and, when the robot walked, ``specific_resistance`` ξ of Eq. 6.6 with
-    E = Σ E_el (Eq. 6.7) and l = ``distance_walked_m``. :meth:`Results.from_engine` adds those
+    E = Σ E_el (Eq. 6.7) and l = ``distance_walked_m``. :func:`add_energy_figures` adds those
     the engine's summary does not already hold.
     """
     b = energy_breakdown(results)
@@ -306,3 +299,11 @@ def energy_figures(results: Results) -> dict[str, float]:
     if distance is not None and distance > 0:
         figures["specific_resistance"] = specific_resistance(e_el, mass, float(distance))
     return figures
+
+
+def add_energy_figures(results: Results) -> None:
+    """Adds to ``results.summary`` the figures of :func:`energy_figures` it does not hold yet
+    (the engine's own ``robot_mass_kg``, ``average_power_w`` and ``specific_resistance`` win).
+    :func:`hexadyn.simulate` calls it on every run."""
+    for key, value in energy_figures(results).items():
+        results.summary.setdefault(key, value)

@@ -32,6 +32,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from hexadyn import energy
+from hexadyn.vocabulary import JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -73,8 +74,9 @@ ENERGY_COLOURS = {"joule_j": "#c0392b", "friction_j": "#7f8c8d", "mechanical_j":
 ENERGY_LABELS = {"joule_j": "Joule losses", "friction_j": "friction work", "mechanical_j": "mechanical work", "magnetic_j": "magnetic energy change"}
 
 #: Display scale and unit of joint positions per joint type: degrees and millimetres (Figs. 6.4-6.15).
-_POSITION = {"q_r": (180.0 / np.pi, "deg"), "q_v": (1e3, "mm"), "q_h": (1e3, "mm")}
-_JOINT_NAMES = {"q_r": "rotational", "q_v": "vertical", "q_h": "horizontal"}
+_POSITION = dict(zip(JOINT_TYPES, [(180.0 / np.pi, "deg"), (1e3, "mm"), (1e3, "mm")]))
+_JOINT_NAMES = dict(zip(JOINT_TYPES, ["rotational", "vertical", "horizontal"]))
+_LEG_RANGE = f"{LEGS[0]}..{LEGS[-1]}"
 
 __all__ = [
     "DEFAULT_FORMATS",
@@ -123,12 +125,12 @@ def _shade_phases(axes: Iterable, results: Results, leg: int) -> list[Patch]:
     t = phases.index.to_numpy()
     dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
     code = phases[leg].to_numpy()
-    double = (phases.to_numpy() == energy.SUPPORT).all(axis=1)
+    double = (phases.to_numpy() == SUPPORT).all(axis=1)
     masks = {
         "double stance": double,
-        "takeoff": code == energy.TAKEOFF,
-        "swing": code == energy.SWING,
-        "landing": code == energy.LANDING,
+        "takeoff": code == TAKEOFF,
+        "swing": code == SWING,
+        "landing": code == LANDING,
     }
     spans = {name: _spans(t, dt, mask) for name, mask in masks.items()}
     for ax in axes:
@@ -153,13 +155,14 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
     unpowered scenario) the error panel is left out.
     """
     _check_leg(leg)
-    if joint not in energy.JOINT_TYPES:
-        raise ValueError(f"joint = {joint!r}; allowed: {', '.join(energy.JOINT_TYPES)}")
+    if joint not in JOINT_TYPES:
+        raise ValueError(f"joint = {joint!r}; allowed: {', '.join(JOINT_TYPES)}")
     ts = results.timeseries
-    name = energy.actuator(joint, leg)
+    name = actuator(joint, leg)
     scale, unit = _POSITION[joint]
     t = ts.index.to_numpy()
-    has_ref = f"{joint}_ref[{leg}]" in ts.columns
+    reference = leg_column(f"{joint}_ref", leg)
+    has_ref = reference in ts.columns
     p = energy.power(results)[name]
     with style():
         fig = Figure(figsize=(6.3, 7.2 if has_ref else 6.0))
@@ -168,18 +171,18 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
         ax = next(it)
         ax.plot(t, ts[name] * scale, color=SIMULATED, label="simulated")
         if has_ref:
-            ax.plot(t, ts[f"{joint}_ref[{leg}]"] * scale, color=REFERENCE, linestyle="--", label="reference")
+            ax.plot(t, ts[reference] * scale, color=REFERENCE, linestyle="--", label="reference")
         ax.set_ylabel(f"${joint}$ [{unit}]")
         handles, _ = ax.get_legend_handles_labels()
         if has_ref:
             ax = next(it)
-            ax.plot(t, (ts[f"{joint}_ref[{leg}]"] - ts[name]) * scale, color=SIMULATED)
+            ax.plot(t, (ts[reference] - ts[name]) * scale, color=SIMULATED)
             ax.set_ylabel(f"tracking error [{unit}]")
         ax = next(it)
-        ax.plot(t, ts[f"i_{name}"], color=SIMULATED)
+        ax.plot(t, ts[actuator_column("i", name)], color=SIMULATED)
         ax.set_ylabel("current [A]")
         ax = next(it)
-        ax.plot(t, ts[f"u_{name}"], color=SIMULATED, drawstyle="steps-pre")
+        ax.plot(t, ts[actuator_column("u", name)], color=SIMULATED, drawstyle="steps-pre")
         ax.set_ylabel("voltage [V]")
         ax = next(it)
         ax.plot(p.index.to_numpy(), p.to_numpy(), color=SIMULATED, drawstyle="steps-pre")
@@ -200,15 +203,15 @@ def gait_diagram(results: Results) -> Figure:
         raise ValueError("gait diagram: these results have no foot phases (not a walking scenario)")
     t = phases.index.to_numpy()
     dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
-    legend = {"support": ((energy.SUPPORT,), "black"), "takeoff / landing": ((energy.TAKEOFF, energy.LANDING), "0.6")}
+    legend = {"support": ((SUPPORT,), "black"), "takeoff / landing": ((TAKEOFF, LANDING), "0.6")}
     with style():
         fig = Figure(figsize=(6.3, 2.4))
         ax = fig.subplots()
-        for row, leg in enumerate(energy.LEGS):
+        for row, leg in enumerate(LEGS):
             for codes, colour in legend.values():
                 ax.broken_barh(_spans(t, dt, np.isin(phases[leg].to_numpy(), codes)), (row - 0.35, 0.7), facecolor=colour, edgecolor="none")
-        ax.set_yticks(range(len(energy.LEGS)), [f"leg {leg}" for leg in energy.LEGS])
-        ax.set_ylim(len(energy.LEGS) - 0.5, -0.5)
+        ax.set_yticks(range(len(LEGS)), [f"leg {leg}" for leg in LEGS])
+        ax.set_ylim(len(LEGS) - 0.5, -0.5)
         ax.set_xlim(t[0] - dt, t[-1])
         ax.set_xlabel("time [s]")
         ax.grid(axis="y", visible=False)
@@ -228,11 +231,11 @@ def trajectory_figure(results: Results) -> Figure:
     with style():
         fig = Figure(figsize=(6.3, 4.4))
         path, error = fig.subplots(2, 1, height_ratios=[2, 1])
-        for leg in energy.LEGS:
+        for leg in LEGS:
             # A foothold: where the foot is at the first instant of each support run.
-            support = phases[leg].to_numpy() == energy.SUPPORT
+            support = phases[leg].to_numpy() == SUPPORT
             first = np.flatnonzero(support & ~np.concatenate([[False], support[:-1]]))
-            x, y = ts[f"foot_x[{leg}]"].to_numpy()[1:][first], ts[f"foot_y[{leg}]"].to_numpy()[1:][first]
+            x, y = ts[leg_column("foot_x", leg)].to_numpy()[1:][first], ts[leg_column("foot_y", leg)].to_numpy()[1:][first]
             path.plot(x * 1e3, y * 1e3, linestyle="none", marker="o", markersize=2.5, color="0.6", label="footholds" if leg == 0 else None)
         path.plot(ts["X_ref"] * 1e3, ts["Y_ref"] * 1e3, color=REFERENCE, linestyle="--", label="reference")
         path.plot(ts["X"] * 1e3, ts["Y"] * 1e3, color=SIMULATED, label="body")
@@ -283,13 +286,13 @@ def energy_breakdown_figure(results: Results) -> Figure:
 
 def _per_actuator(block: pd.DataFrame) -> pd.Series:
     """A (leg x joint type) block of :func:`energy.averaged_power` as one value per actuator."""
-    return pd.Series({energy.actuator(j, leg): block.loc[leg, j] for leg in energy.LEGS for j in energy.JOINT_TYPES})
+    return pd.Series({actuator(j, leg): block.loc[leg, j] for leg in LEGS for j in JOINT_TYPES})
 
 
 def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], labels: Mapping[str, str]) -> np.ndarray:
     """Bars of the 18 actuators grouped by leg, the columns of `parts` stacked (positive parts
     upwards from zero, negative ones downwards); returns the bar positions."""
-    x = np.array([4 * leg + k for leg in energy.LEGS for k in range(len(energy.JOINT_TYPES))], dtype=float)
+    x = np.array([4 * leg + k for leg in LEGS for k in range(len(JOINT_TYPES))], dtype=float)
     up = np.zeros(len(x))
     down = np.zeros(len(x))
     for column in parts.columns:
@@ -299,11 +302,11 @@ def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], 
         up += np.clip(v, 0, None)
         down += np.clip(v, None, 0)
     ax.axhline(0, color="black", linewidth=0.6)
-    ax.set_xticks(x, [j.replace("q_", "") for _ in energy.LEGS for j in energy.JOINT_TYPES])
+    ax.set_xticks(x, [j.replace("q_", "") for _ in LEGS for j in JOINT_TYPES])
     ax.tick_params(axis="x", length=0)
     ax.grid(axis="x", visible=False)
     groups = ax.secondary_xaxis(-0.09)
-    groups.set_xticks([4 * leg + 1 for leg in energy.LEGS], [f"leg {leg}" for leg in energy.LEGS])
+    groups.set_xticks([4 * leg + 1 for leg in LEGS], [f"leg {leg}" for leg in LEGS])
     groups.tick_params(length=0)
     groups.spines["bottom"].set_visible(False)
     ax.legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=5, frameon=False, borderaxespad=0)
@@ -318,19 +321,19 @@ def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], 
 def parse_legs(text: str) -> tuple[int, ...]:
     """Legs from the command line: ``"0,2"`` or ``"all"``."""
     if text.strip().lower() == "all":
-        return energy.LEGS
+        return LEGS
     try:
         legs = tuple(int(s) for s in text.split(","))
     except ValueError:
-        raise ValueError(f"legs = {text!r}; allowed: comma-separated legs 0..5 (e.g. 0,2) or all") from None
+        raise ValueError(f"legs = {text!r}; allowed: comma-separated legs {_LEG_RANGE} (e.g. 0,2) or all") from None
     for leg in legs:
         _check_leg(leg)
     return tuple(dict.fromkeys(legs))
 
 
 def _check_leg(leg: int) -> None:
-    if leg not in energy.LEGS:
-        raise ValueError(f"leg = {leg!r}; allowed: 0..5")
+    if leg not in LEGS:
+        raise ValueError(f"leg = {leg!r}; allowed: {_LEG_RANGE}")
 
 
 def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, Figure]:
@@ -339,7 +342,7 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
     ``energy_breakdown``."""
     for leg in legs:
         _check_leg(leg)
-    out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in energy.JOINT_TYPES}
+    out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in JOINT_TYPES}
     if energy.foot_phases(results) is not None:
         out["gait_diagram"] = gait_diagram(results)
     if "X_ref" in results.timeseries.columns:
@@ -352,7 +355,7 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
 def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS) -> list[Path]:
     """Writes every figure as ``folder/<stem>.<format>`` (PNG at 300 dpi); returns the paths.
 
-    The folder must exist. Use :meth:`hexadyn.Results.plot` or :meth:`hexadyn.Results.save` to
+    The folder must exist. Use :func:`hexadyn.report.plot` or :func:`hexadyn.report.save` to
     write a complete plots folder atomically.
     """
     bad = [f for f in formats if f not in FORMATS]

@@ -13,6 +13,7 @@ import os
 from pathlib import Path
 from typing import Any, Callable, Mapping, Union
 
+from hexadyn import atomic
 from hexadyn.results import Results
 
 #: Folder of the scenario files shipped with the package.
@@ -57,12 +58,14 @@ def simulate(
     overwrite: bool = False,
     overrides: Mapping[str, Any] | None = None,
 ) -> Results:
-    """Runs a scenario and returns its :class:`~hexadyn.results.Results`.
+    """Runs a scenario and returns its :class:`~hexadyn.results.Results`, whose summary also
+    holds the key figures of the power analysis (:func:`hexadyn.energy.add_energy_figures`).
 
     Args:
         scenario: a scenario file, or the name of a shipped scenario (see :func:`list_scenarios`).
-        out: if given, the results are also saved to this folder (atomically, see
-            :meth:`Results.save`); it must not exist unless ``overwrite`` is true.
+        out: if given, the results are also saved to this folder (atomically, with the power
+            tables, see :func:`hexadyn.report.save`); it must not exist unless ``overwrite``
+            is true.
         progress: True for a tqdm progress bar over the simulated time (on stderr), False for
             none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
         overwrite: replace an existing ``out`` folder.
@@ -77,19 +80,20 @@ def simulate(
             what is allowed), or the simulation failed.
         FileExistsError: ``out`` exists and ``overwrite`` is false (checked before running).
     """
-    from hexadyn import _core
+    from hexadyn import _core, energy, report  # pandas and matplotlib: not at `import hexadyn`
 
     path = resolve_scenario(scenario)
-    if out is not None and Path(out).exists() and not overwrite:
-        raise FileExistsError(errno.EEXIST, "the results folder exists (choose another folder or overwrite it)", os.fspath(out))
+    if out is not None and not overwrite:
+        atomic.refuse_existing(out, "results folder")
     overrides = dict(overrides) if overrides else None
     if progress is True:
         raw = _run_with_bar(_core, path, overrides)
     else:
         raw = _core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides)
     results = Results.from_engine(raw, scenario_path=path)
+    energy.add_energy_figures(results)
     if out is not None:
-        results.save(out, overwrite=overwrite)
+        report.save(results, out, overwrite=overwrite)
     return results
 
 

@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 import hexadyn
-from hexadyn import Results, energy
+from hexadyn import Results, energy, report
 
 from conftest import shortened
 
@@ -154,7 +154,7 @@ def test_power_velocity_fit_recovers_alpha_beta():
 
 
 def test_saved_tables_and_summary(walk: Results, tmp_path: Path):
-    folder = walk.save(tmp_path / "run")
+    folder = report.save(walk, tmp_path / "run")
     power = pd.read_csv(folder / "power.csv", index_col=["phase", "leg"])
     expected = energy.averaged_power(walk)
     np.testing.assert_allclose(power.to_numpy(), expected.to_numpy(), rtol=1e-8)

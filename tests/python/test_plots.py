@@ -1,4 +1,4 @@
-"""Figures (hexadyn.plots), Results.plot and the plots written by `hexadyn simulate` and
+"""Figures (hexadyn.plots), report.plot and the plots written by `hexadyn simulate` and
 `hexadyn plot`: every PNG must hold drawn content, and a failure must leave nothing behind."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from matplotlib.figure import Figure
 
 import hexadyn
-from hexadyn import Results, plots
+from hexadyn import Results, plots, report
 from hexadyn.cli import cli
 
 from conftest import assert_drawn, shortened
@@ -19,7 +19,7 @@ WALK_STEMS = {"gait_diagram", "trajectory", "averaged_power", "energy_breakdown"
 
 
 def test_results_plot_writes_every_figure(walk: Results, tmp_path: Path):
-    figures = walk.plot(tmp_path / "plots", legs=[2])
+    figures = report.plot(walk, tmp_path / "plots", legs=[2])
     assert set(figures) == {"leg2_q_r", "leg2_q_v", "leg2_q_h"} | WALK_STEMS
     assert all(isinstance(f, Figure) for f in figures.values())
     assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == sorted(f"{s}.png" for s in figures)
@@ -32,7 +32,7 @@ def test_results_plot_writes_every_figure(walk: Results, tmp_path: Path):
     legend = [t.get_text() for t in figures["leg2_q_v"].axes[0].get_legend().get_texts()]
     assert legend[:2] == ["simulated", "reference"] and {"swing", "takeoff", "landing", "double stance"} <= set(legend)
     # Regenerating replaces the folder's content atomically.
-    walk.plot(tmp_path / "plots", legs=[], formats=["svg", "pdf"])
+    report.plot(walk, tmp_path / "plots", legs=[], formats=["svg", "pdf"])
     assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == sorted(f"{s}.{f}" for s in WALK_STEMS for f in ("svg", "pdf"))
     assert (tmp_path / "plots" / "gait_diagram.pdf").read_bytes().startswith(b"%PDF")
     assert [p.name for p in tmp_path.iterdir()] == ["plots"]
@@ -48,9 +48,9 @@ def test_parse_legs():
 
 def test_plot_errors_leave_nothing(walk: Results, tmp_path: Path, monkeypatch):
     with pytest.raises(ValueError, match=r"leg = 6; allowed: 0\.\.5"):
-        walk.plot(tmp_path / "p", legs=[6])
+        report.plot(walk, tmp_path / "p", legs=[6])
     with pytest.raises(ValueError, match="allowed: one or more of png, pdf, svg"):
-        walk.plot(tmp_path / "p", formats=["jpeg"])
+        report.plot(walk, tmp_path / "p", formats=["jpeg"])
     with pytest.raises(ValueError, match="joint = 'q_x'"):
         plots.joint_figure(walk, 0, "q_x")
     assert list(tmp_path.iterdir()) == []
@@ -64,7 +64,7 @@ def test_plot_errors_leave_nothing(walk: Results, tmp_path: Path, monkeypatch):
 
     monkeypatch.setattr(plots, "save_figures", failing)
     with pytest.raises(OSError, match="No space left"):
-        walk.save(tmp_path / "run", plots=True, legs=[0])
+        report.save(walk, tmp_path / "run", plots=True, legs=[0])
     assert list(tmp_path.iterdir()) == []
 
 

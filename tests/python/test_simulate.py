@@ -13,7 +13,7 @@ import pytest
 from click.testing import CliRunner
 
 import hexadyn
-from hexadyn import Results, _core
+from hexadyn import Results, _core, report
 from hexadyn import results as results_module
 from hexadyn.cli import DEFAULT_SCENARIO, cli
 
@@ -151,7 +151,7 @@ def test_progress_exception_stops_the_run(sine_file: Path):
 
 
 def test_save_load_round_trip(sine: Results, tmp_path: Path):
-    folder = sine.save(tmp_path / "nested" / "run")
+    folder = report.save(sine, tmp_path / "nested" / "run")
     assert sorted(p.name for p in folder.iterdir()) == ["energy.csv", "metadata.json", "power.csv", "summary.json", "timeseries.parquet"]
     assert [p.name for p in folder.parent.iterdir()] == ["run"], "no temporary folders left"
     loaded = Results.load(folder)
@@ -170,8 +170,8 @@ def test_save_load_round_trip(sine: Results, tmp_path: Path):
     assert units["i_q_v[1]"] == "A"
 
     with pytest.raises(FileExistsError):
-        sine.save(folder)
-    sine.save(folder, overwrite=True)
+        report.save(sine, folder)
+    report.save(sine, folder, overwrite=True)
     assert Results.load(folder).summary == sine.summary
     assert sorted(p.name for p in folder.parent.iterdir()) == ["run"]
     with pytest.raises(ValueError, match="not a hexadyn results folder"):
@@ -190,17 +190,17 @@ def test_atomic_save_leaves_nothing_on_failure(sine: Results, tmp_path: Path, mo
 
     monkeypatch.setattr(results_module, "_write_json", failing)
     with pytest.raises(OSError, match="No space left"):
-        sine.save(tmp_path / "new" / "run")
+        report.save(sine, tmp_path / "new" / "run")
     assert calls == ["metadata.json", "summary.json"]
     assert list(tmp_path.iterdir()) == [], "neither the folder, its new parent nor a temporary folder is left"
 
     # Overwriting: a failure keeps the previous results intact.
     monkeypatch.setattr(results_module, "_write_json", real)
-    folder = sine.save(tmp_path / "run")
+    folder = report.save(sine, tmp_path / "run")
     before = {p.name: p.read_bytes() for p in folder.iterdir()}
     monkeypatch.setattr(results_module, "_write_json", failing)
     with pytest.raises(OSError):
-        sine.save(folder, overwrite=True)
+        report.save(sine, folder, overwrite=True)
     assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
     assert [p.name for p in tmp_path.iterdir()] == ["run"]
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence, Union
 
+from hexadyn._core import __version__
 from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction
 from hexadyn.montecarlo.storage import CampaignStore, RunKey
@@ -121,8 +122,6 @@ class Campaign:
 
     def configuration(self) -> dict[str, Any]:
         """The content of ``campaign.json``: what must match to resume a campaign."""
-        from hexadyn import __version__
-
         d = self.distributions
         return {
             "hexadyn_version": __version__,

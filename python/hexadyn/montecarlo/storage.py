@@ -8,7 +8,8 @@ run: an interrupted campaign loses at most the runs that were still being simula
 primary key forbids duplicates. Failed simulations are stored too (status ``failed`` and the
 error message), so a resumed campaign does not retry them.
 
-Output files (tables, plots) are written atomically with :func:`write_atomically`.
+``campaign.json`` and the output files (tables, plots) are written atomically
+(:func:`hexadyn.atomic.write_file`).
 """
 
 from __future__ import annotations
@@ -16,11 +17,12 @@ from __future__ import annotations
 import json
 import os
 import sqlite3
-import tempfile
 from pathlib import Path
-from typing import Any, Callable, Mapping, NamedTuple
+from typing import Any, Mapping, NamedTuple
 
-__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey", "write_atomically"]
+from hexadyn import atomic
+
+__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey"]
 
 CAMPAIGN_FILE = "campaign.json"
 DATABASE_FILE = "runs.sqlite"
@@ -92,7 +94,7 @@ class CampaignStore:
         else:
             folder.mkdir(parents=True, exist_ok=True)
             text = json.dumps({"format": FORMAT, "configuration": dict(configuration)}, indent=2) + "\n"
-            write_atomically(config_file, lambda tmp: tmp.write_text(text))
+            atomic.write_file(config_file, lambda tmp: tmp.write_text(text))
         connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
         with connection:
             connection.execute(_SCHEMA)
@@ -154,24 +156,3 @@ def _check_same_configuration(config_file: Path, configuration: Mapping[str, Any
 def _short(value: Any) -> str:
     text = json.dumps(value)
     return text if len(text) <= 60 else text[:57] + "..."
-
-
-def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
-    """Calls ``write(tmp)`` on a temporary file next to ``path``, then renames it to ``path``:
-    the file appears complete or not at all (a failure removes the temporary file)."""
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
-    os.close(fd)
-    tmp = Path(name)
-    try:
-        write(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

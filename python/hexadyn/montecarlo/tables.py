@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from hexadyn.montecarlo.storage import write_atomically
+from hexadyn import atomic
 
 __all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "write_table", "plot_specific_resistance"]
 
@@ -58,7 +58,7 @@ def specific_resistance_table(runs: pd.DataFrame, variants: tuple[str, ...]) -> 
 def write_table(table: pd.DataFrame, folder: Path) -> Path:
     """Writes Table 6.8 as ``specific_resistance.csv`` (atomically)."""
     path = folder / TABLE_FILE
-    write_atomically(path, lambda tmp: table.to_csv(tmp, index=False, float_format="%.17g"))
+    atomic.write_file(path, lambda tmp: table.to_csv(tmp, index=False, float_format="%.17g"))
     return path
 
 
@@ -93,7 +93,7 @@ def plot_specific_resistance(table: pd.DataFrame, folder: Path) -> list[Path]:
         for name in FIGURE_FILES:
             path = folder / name
             fmt = path.suffix[1:]
-            write_atomically(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=300))
+            atomic.write_file(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=300))
             paths.append(path)
     finally:
         plt.close(fig)

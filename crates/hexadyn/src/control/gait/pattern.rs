@@ -71,6 +71,20 @@ pub enum FootPhase {
 }
 
 impl FootPhase {
+    /// The four phases in the order of a cycle's foot phase codes (0 support, 1 takeoff,
+    /// 2 swing, 3 landing).
+    pub const ALL: [FootPhase; 4] = [FootPhase::Support, FootPhase::Takeoff, FootPhase::Swing, FootPhase::Landing];
+
+    /// The phase's name as in the thesis (Section 7.6): `support`, `takeoff`, `swing`, `landing`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FootPhase::Support => "support",
+            FootPhase::Takeoff => "takeoff",
+            FootPhase::Swing => "swing",
+            FootPhase::Landing => "landing",
+        }
+    }
+
     pub fn on_ground(self) -> bool {
         self == FootPhase::Support
     }

@@ -1,0 +1,57 @@
+//! The engine's schema for the Python front end, so that Python never restates it: the joint
+//! names and the number of legs of the column names, the foot phase codes of the `phase[l]`
+//! columns, the robot's mass and motor inductance as the engine reads its description, and the
+//! specific resistance of Eq. 6.6.
+
+use hexadyn::control::gait::pattern::FootPhase;
+use hexadyn::description::RobotDescription;
+use hexadyn::hexapod::{Joint, LEG_COUNT};
+use hexadyn::scenario::phase_code;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+/// Adds `JOINT_NAMES` (the joint symbols in the thesis order, `("q_r", "q_v", "q_h")`),
+/// `LEG_COUNT` (6) and `PHASE_CODES` (foot phase name -> code of the `phase[l]` columns:
+/// support 0, takeoff 1, swing 2, landing 3) and the functions of this module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("JOINT_NAMES", PyTuple::new(py, Joint::ALL.map(Joint::symbol))?)?;
+    m.add("LEG_COUNT", LEG_COUNT)?;
+    let phases = PyDict::new(py);
+    for phase in FootPhase::ALL {
+        // The codes are small integers stored as floats in the time series.
+        phases.set_item(phase.name(), phase_code(phase) as u8)?;
+    }
+    m.add("PHASE_CODES", phases)?;
+    m.add_function(wrap_pyfunction!(robot_properties, m)?)?;
+    m.add_function(wrap_pyfunction!(specific_resistance, m)?)?;
+    Ok(())
+}
+
+/// Reads a robot description text (`origin` names it in errors) and returns a dict:
+///
+/// - "mass_kg": m_0 + 6 m_leg (Table B.2), the mass the engine simulates and reports as the
+///   summary's `robot_mass_kg`;
+/// - "stated_mass_kg": `inertia.total_mass_kg`, the total mass as printed in Table B.2
+///   ("about 34 kg", checked against m_0 + 6 m_leg within 5 %);
+/// - "inductance_h": the motor inductance L (H) of Eq. 3.91.
+///
+/// Raises ValueError (one line naming `origin` and the field) for an invalid description.
+#[pyfunction]
+#[pyo3(signature = (text, origin = "robot description"))]
+pub fn robot_properties<'py>(py: Python<'py>, text: &str, origin: &str) -> PyResult<Bound<'py, PyDict>> {
+    let robot = RobotDescription::from_str(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    d.set_item("mass_kg", robot.total_mass_kg())?;
+    d.set_item("stated_mass_kg", robot.inertia.total_mass_kg)?;
+    d.set_item("inductance_h", robot.motor.inductance_h())?;
+    Ok(d)
+}
+
+/// Specific resistance ξ = E / (m g l) (Eq. 6.6), g the engine's standard gravity: the formula
+/// of the summary's `specific_resistance`. NaN when the distance is not positive.
+#[pyfunction]
+pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 {
+    hexadyn::scenario::specific_resistance(energy_j, mass_kg, distance_m)
+}

@@ -1,0 +1,108 @@
+"""A results folder with its analysis, written atomically (all or nothing)::
+
+    from hexadyn import report
+    report.save(results, "results/walk", plots=True)    # the folder below
+    report.plot(results, "results/walk/plots")          # (re)writes the figures only
+
+The folder holds the files of :class:`~hexadyn.results.Results` (``timeseries.parquet``,
+``metadata.json``, ``summary.json``; read back by :meth:`Results.load
+<hexadyn.results.Results.load>`) and:
+
+- ``power.csv``: averaged power per leg and joint type, split by foot phase
+  (:func:`hexadyn.energy.averaged_power`, Tables 6.3-6.6);
+- ``energy.csv``: energy breakdown per actuator (:func:`hexadyn.energy.energy_breakdown`);
+- ``plots/`` (on request): the figures of :func:`hexadyn.plots.figures`.
+
+This module is the top of the analysis layers (results -> energy -> plots -> report).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import pandas as pd
+from matplotlib.figure import Figure
+
+from hexadyn import atomic, energy
+from hexadyn import plots as plotting
+from hexadyn.results import Results
+
+POWER_FILE = "power.csv"
+ENERGY_FILE = "energy.csv"
+PLOTS_DIR = "plots"
+
+__all__ = ["ENERGY_FILE", "PLOTS_DIR", "POWER_FILE", "plot", "save", "write_csv"]
+
+
+def save(
+    results: Results,
+    folder: str | os.PathLike,
+    *,
+    overwrite: bool = False,
+    plots: bool = False,
+    legs: Sequence[int] | None = None,
+    formats: Sequence[str] | None = None,
+) -> Path:
+    """Writes the results folder atomically and returns its path (also set as ``results.path``).
+
+    The files (and with ``plots`` the figures of :func:`plot` in ``plots/``) are written into a
+    temporary folder next to ``folder`` which is then renamed to ``folder``: either the complete
+    folder appears or nothing does (a failure removes the temporary folder and any parent
+    folders this call created). An existing ``folder`` is an error (FileExistsError) unless
+    ``overwrite`` is true, in which case it is replaced only once the new folder is complete.
+    ``legs`` and ``formats`` are those of :func:`plot`.
+    """
+    target = Path(folder)
+    if not overwrite:
+        atomic.refuse_existing(target, "results folder")
+    figures = _figures(results, legs) if plots else None  # before anything is written
+
+    def write(tmp: Path) -> None:
+        results.write(tmp)
+        write_csv(tmp / POWER_FILE, energy.averaged_power(results))
+        write_csv(tmp / ENERGY_FILE, energy.energy_breakdown(results))
+        if figures is not None:
+            (tmp / PLOTS_DIR).mkdir()
+            _save_figures(figures, tmp / PLOTS_DIR, formats)
+
+    atomic.write_folder(target, write)
+    results.path = target
+    return target
+
+
+def plot(
+    results: Results,
+    folder: str | os.PathLike | None = None,
+    *,
+    legs: Sequence[int] | None = None,
+    formats: Sequence[str] | None = None,
+) -> dict[str, Figure]:
+    """Builds the figures of the results and, with ``folder``, writes them there.
+
+    Returns the matplotlib figures by file stem (``leg0_q_r``, ..., ``gait_diagram``,
+    ``trajectory``, ``averaged_power``, ``energy_breakdown``; see :mod:`hexadyn.plots`).
+    ``legs``: the legs of the per-actuator figures (default 0 and 2, as in Section 6.4).
+    ``formats``: file formats among png (300 dpi), pdf and svg (default png). The folder is
+    written atomically and replaces an existing one: ``report.plot(results, results.path /
+    "plots")`` regenerates the plots of a saved results folder.
+    """
+    figures = _figures(results, legs)
+    if folder is not None:
+        atomic.write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats))
+    return figures
+
+
+def write_csv(path: Path, table: pd.DataFrame) -> None:
+    """Writes a table as CSV (floats with 9 significant digits)."""
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        table.to_csv(f, float_format="%.9g")
+
+
+def _figures(results: Results, legs: Sequence[int] | None) -> dict[str, Figure]:
+    return plotting.figures(results, plotting.DEFAULT_LEGS if legs is None else legs)
+
+
+def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence[str] | None) -> None:
+    plotting.save_figures(figures, folder, plotting.DEFAULT_FORMATS if formats is None else formats)
