@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-use super::{RigidBody, RobotDescription};
+use super::{RigidBodyTable, RobotDescription};
 use crate::hexapod::{Inertia, Joint, JointLimits, LegKinematics, LegKinematicsError, MechanicsParameters, PantographGeometry};
 
 impl MechanicsParameters {
@@ -18,7 +18,7 @@ impl MechanicsParameters {
     pub fn from_description(d: &RobotDescription) -> Self {
         let g = &d.geometry;
         let pg = &g.pantograph;
-        let inertia = |b: &RigidBody| Inertia { mass: b.mass_kg, moments: Vector3::from(b.principal_moments()) };
+        let inertia = |b: &RigidBodyTable| Inertia { mass: b.mass_kg, moments: Vector3::from(b.principal_moments()) };
         let i = &d.inertia;
         MechanicsParameters {
             pantograph: PantographGeometry { l0: pg.l_0_m, l1: pg.l_1_m, l2: pg.l_2_m, l3: pg.l_3_m, c: pg.c_m },

@@ -5,16 +5,16 @@
 //! to the joint is -τ_f. For a translational joint the "torque" is a force in N and q' is in m/s
 //! (footnote of Eq. 3.86).
 //!
-//! Direction-dependent parameters (Section 6.1): the `_pos` parameters hold for q' ≥ 0 and the
-//! `_neg` ones for q' < 0. As in Tables 5.3-5.5, the negative-direction dry friction τ_f,d^-,
+//! Direction-dependent parameters (Section 6.1): the `_plus` parameters hold for q' ≥ 0 and the
+//! `_minus` ones for q' < 0. As in Tables 5.3-5.5, the negative-direction dry friction τ_f,d^-,
 //! stiction τ_f,s^- and load coefficients a_2^-, a_1^- are negative numbers, while both viscous
 //! coefficients f_v^± are non-negative (Eq. 6.1 adds f_v^- q' with q' < 0).
 //!
-//! Non-smooth points: |q'| and the switch between `_pos` and `_neg` parameters make the laws
+//! Non-smooth points: |q'| and the switch between `_plus` and `_minus` parameters make the laws
 //! non-differentiable at q' = 0 (Eq. 6.1 also at q' = ±ε); the values are continuous there.
 //! Every partial derivative returned at such a point is the one-sided derivative of the branch
 //! that owns the point: q' = 0 belongs to the q' ≥ 0 branch (right derivative, d|q'|/dq' = +1 with
-//! the `_pos` parameters) and q' = ±ε to the linear zone of Eq. 6.1.
+//! the `_plus` parameters) and q' = ±ε to the linear zone of Eq. 6.1.
 //!
 //! Per joint, the quantities worth recording are the friction torque ([`FrictionTorque::tau`]),
 //! the bristle state z = q'_z and the load fed to [`FrictionElement`].
@@ -56,7 +56,7 @@ fn require(parameter: &'static str, value: f64, ok: bool, expected: &'static str
     }
 }
 
-/// Whether q' uses the `_pos` parameters (Section 6.1: q' ≥ 0).
+/// Whether q' uses the `_plus` parameters (Section 6.1: q' ≥ 0).
 fn positive(qd: f64) -> bool {
     qd >= 0.0
 }
@@ -65,13 +65,13 @@ fn positive(qd: f64) -> bool {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DryViscous {
     /// τ_f,d^+ ≥ 0 (Nm or N).
-    pub tau_d_pos: f64,
+    pub tau_f_d_plus: f64,
     /// τ_f,d^- ≤ 0 (Nm or N).
-    pub tau_d_neg: f64,
+    pub tau_f_d_minus: f64,
     /// f_v^+ ≥ 0 (Nms/rad or Ns/m).
-    pub f_v_pos: f64,
+    pub f_v_plus: f64,
     /// f_v^- ≥ 0 (Nms/rad or Ns/m).
-    pub f_v_neg: f64,
+    pub f_v_minus: f64,
     /// Half width ε > 0 of the linear zone (rad/s or m/s).
     pub epsilon: f64,
 }
@@ -80,26 +80,26 @@ impl DryViscous {
     /// Eq. 6.1 with ε = LINEAR_ZONE, from the identified parameters of Table 5.3; negative
     /// (non-physical) viscous coefficients are forced to zero as in Section 6.1.
     #[cfg(test)]
-    fn new(tau_d_pos: f64, tau_d_neg: f64, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
-        let law = DryViscous { tau_d_pos, tau_d_neg, f_v_pos: f_v_pos.max(0.0), f_v_neg: f_v_neg.max(0.0), epsilon: LINEAR_ZONE };
+    fn new(tau_f_d_plus: f64, tau_f_d_minus: f64, f_v_plus: f64, f_v_minus: f64) -> Result<Self, FrictionError> {
+        let law = DryViscous { tau_f_d_plus, tau_f_d_minus, f_v_plus: f_v_plus.max(0.0), f_v_minus: f_v_minus.max(0.0), epsilon: LINEAR_ZONE };
         law.validate()?;
         Ok(law)
     }
 
     pub fn validate(&self) -> Result<(), FrictionError> {
-        require("tau_d_pos", self.tau_d_pos, self.tau_d_pos >= 0.0, ">= 0")?;
-        require("tau_d_neg", self.tau_d_neg, self.tau_d_neg <= 0.0, "<= 0 (negative-direction dry friction, Table 5.3)")?;
-        require("f_v_pos", self.f_v_pos, self.f_v_pos >= 0.0, ">= 0")?;
-        require("f_v_neg", self.f_v_neg, self.f_v_neg >= 0.0, ">= 0")?;
+        require("tau_f_d_plus", self.tau_f_d_plus, self.tau_f_d_plus >= 0.0, ">= 0")?;
+        require("tau_f_d_minus", self.tau_f_d_minus, self.tau_f_d_minus <= 0.0, "<= 0 (negative-direction dry friction, Table 5.3)")?;
+        require("f_v_plus", self.f_v_plus, self.f_v_plus >= 0.0, ">= 0")?;
+        require("f_v_minus", self.f_v_minus, self.f_v_minus >= 0.0, ">= 0")?;
         require("epsilon", self.epsilon, self.epsilon > 0.0, "> 0")
     }
 
     /// Dry friction of the direction of q'.
     fn dry(&self, qd: f64) -> f64 {
         if positive(qd) {
-            self.tau_d_pos
+            self.tau_f_d_plus
         } else {
-            self.tau_d_neg
+            self.tau_f_d_minus
         }
     }
 
@@ -119,15 +119,15 @@ impl DryViscous {
     fn torque_with_dry(&self, qd: f64, tau_d: f64) -> (f64, f64, f64) {
         let eps = self.epsilon;
         if qd > eps {
-            (tau_d + self.f_v_pos * qd, self.f_v_pos, 1.0)
+            (tau_d + self.f_v_plus * qd, self.f_v_plus, 1.0)
         } else if qd >= 0.0 {
-            let slope = (tau_d + self.f_v_pos * eps) / eps;
+            let slope = (tau_d + self.f_v_plus * eps) / eps;
             (slope * qd, slope, qd / eps)
         } else if qd >= -eps {
-            let slope = (self.f_v_neg * eps - tau_d) / eps;
+            let slope = (self.f_v_minus * eps - tau_d) / eps;
             (slope * qd, slope, -qd / eps)
         } else {
-            (tau_d + self.f_v_neg * qd, self.f_v_neg, 1.0)
+            (tau_d + self.f_v_minus * qd, self.f_v_minus, 1.0)
         }
     }
 }
@@ -137,25 +137,25 @@ impl DryViscous {
 pub enum SteadyState {
     /// Dry friction only, g = τ_f,d^+ / σ0 for q' ≥ 0 and -τ_f,d^- / σ0 for q' < 0: the
     /// rotational joints (Eq. 6.2-6.3) and the horizontal joints (Eq. 5.4, 6.5).
-    Dry { tau_d_pos: f64, tau_d_neg: f64 },
+    Dry { tau_f_d_plus: f64, tau_f_d_minus: f64 },
     /// With the Stribeck effect, g = |τ_f,d + (τ_f,s - τ_f,d) exp(-(q'/q'_st)²)| / σ0: the
     /// vertical joints (Eq. 3.86, 6.4). τ_f,s^± are the stiction of Table 5.4 (10 kg load; the
     /// unloaded dry friction where Table 5.4 has no value, Section 6.1).
-    Stribeck { tau_d_pos: f64, tau_d_neg: f64, tau_s_pos: f64, tau_s_neg: f64, qd_st: f64 },
+    Stribeck { tau_f_d_plus: f64, tau_f_d_minus: f64, tau_f_s_plus: f64, tau_f_s_minus: f64, qd_st: f64 },
 }
 
 impl SteadyState {
     pub fn validate(&self) -> Result<(), FrictionError> {
         match *self {
-            SteadyState::Dry { tau_d_pos, tau_d_neg } => {
-                require("tau_d_pos", tau_d_pos, tau_d_pos > 0.0, "> 0 (g must be positive)")?;
-                require("tau_d_neg", tau_d_neg, tau_d_neg < 0.0, "< 0 (g must be positive)")
+            SteadyState::Dry { tau_f_d_plus, tau_f_d_minus } => {
+                require("tau_f_d_plus", tau_f_d_plus, tau_f_d_plus > 0.0, "> 0 (g must be positive)")?;
+                require("tau_f_d_minus", tau_f_d_minus, tau_f_d_minus < 0.0, "< 0 (g must be positive)")
             }
-            SteadyState::Stribeck { tau_d_pos, tau_d_neg, tau_s_pos, tau_s_neg, qd_st } => {
-                require("tau_d_pos", tau_d_pos, tau_d_pos > 0.0, "> 0 (g must be positive)")?;
-                require("tau_d_neg", tau_d_neg, tau_d_neg < 0.0, "< 0 (g must be positive)")?;
-                require("tau_s_pos", tau_s_pos, tau_s_pos > 0.0, "> 0 (g must be positive)")?;
-                require("tau_s_neg", tau_s_neg, tau_s_neg < 0.0, "< 0 (g must be positive)")?;
+            SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st } => {
+                require("tau_f_d_plus", tau_f_d_plus, tau_f_d_plus > 0.0, "> 0 (g must be positive)")?;
+                require("tau_f_d_minus", tau_f_d_minus, tau_f_d_minus < 0.0, "< 0 (g must be positive)")?;
+                require("tau_f_s_plus", tau_f_s_plus, tau_f_s_plus > 0.0, "> 0 (g must be positive)")?;
+                require("tau_f_s_minus", tau_f_s_minus, tau_f_s_minus < 0.0, "< 0 (g must be positive)")?;
                 require("qd_st", qd_st, qd_st > 0.0, "> 0")
             }
         }
@@ -163,11 +163,11 @@ impl SteadyState {
 
     /// Unloaded dry friction τ_f,d of the direction of q'.
     pub fn dry(&self, qd: f64) -> f64 {
-        let (SteadyState::Dry { tau_d_pos, tau_d_neg } | SteadyState::Stribeck { tau_d_pos, tau_d_neg, .. }) = *self;
+        let (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus } | SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, .. }) = *self;
         if positive(qd) {
-            tau_d_pos
+            tau_f_d_plus
         } else {
-            tau_d_neg
+            tau_f_d_minus
         }
     }
 
@@ -176,8 +176,8 @@ impl SteadyState {
     fn level(&self, qd: f64, tau_d: f64) -> (f64, f64, f64) {
         match *self {
             SteadyState::Dry { .. } => (tau_d, 0.0, 1.0),
-            SteadyState::Stribeck { tau_s_pos, tau_s_neg, qd_st, .. } => {
-                let tau_s = if positive(qd) { tau_s_pos } else { tau_s_neg };
+            SteadyState::Stribeck { tau_f_s_plus, tau_f_s_minus, qd_st, .. } => {
+                let tau_s = if positive(qd) { tau_f_s_plus } else { tau_f_s_minus };
                 let r = qd / qd_st;
                 let e = (-r * r).exp();
                 (tau_d + (tau_s - tau_d) * e, (tau_s - tau_d) * e * (-2.0 * r / qd_st), 1.0 - e)
@@ -198,9 +198,9 @@ pub struct LuGre {
     /// (`f64::INFINITY` keeps σ1 constant).
     pub v_d: f64,
     /// f_v^+ ≥ 0 (Nms/rad or Ns/m).
-    pub f_v_pos: f64,
+    pub f_v_plus: f64,
     /// f_v^- ≥ 0 (Nms/rad or Ns/m).
-    pub f_v_neg: f64,
+    pub f_v_minus: f64,
     pub steady: SteadyState,
 }
 
@@ -215,13 +215,13 @@ impl LuGre {
     /// v_d "in relation to the Stribeck velocity", Section 3.4.3; the thesis gives no value).
     /// Negative (non-physical) viscous coefficients are forced to zero as in Section 6.1.
     #[cfg(test)]
-    fn new(steady: SteadyState, f_v_pos: f64, f_v_neg: f64) -> Result<Self, FrictionError> {
+    fn new(steady: SteadyState, f_v_plus: f64, f_v_minus: f64) -> Result<Self, FrictionError> {
         let law = LuGre {
             sigma_0: BRISTLE_STIFFNESS,
             sigma_1: BRISTLE_DAMPING,
             v_d: STRIBECK_VELOCITY,
-            f_v_pos: f_v_pos.max(0.0),
-            f_v_neg: f_v_neg.max(0.0),
+            f_v_plus: f_v_plus.max(0.0),
+            f_v_minus: f_v_minus.max(0.0),
             steady,
         };
         law.validate()?;
@@ -234,16 +234,16 @@ impl LuGre {
         if self.v_d.is_nan() || self.v_d <= 0.0 {
             return Err(FrictionError { parameter: "v_d", value: self.v_d, expected: "> 0 (infinity for a constant sigma_1)" });
         }
-        require("f_v_pos", self.f_v_pos, self.f_v_pos >= 0.0, ">= 0")?;
-        require("f_v_neg", self.f_v_neg, self.f_v_neg >= 0.0, ">= 0")?;
+        require("f_v_plus", self.f_v_plus, self.f_v_plus >= 0.0, ">= 0")?;
+        require("f_v_minus", self.f_v_minus, self.f_v_minus >= 0.0, ">= 0")?;
         self.steady.validate()
     }
 
     fn viscous(&self, qd: f64) -> f64 {
         if positive(qd) {
-            self.f_v_pos
+            self.f_v_plus
         } else {
-            self.f_v_neg
+            self.f_v_minus
         }
     }
 
@@ -301,21 +301,21 @@ impl LuGre {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LoadDependence {
     /// a_2^+ ≥ 0 (N/kg²).
-    pub a2_pos: f64,
+    pub a_2_plus: f64,
     /// a_1^+ ≥ 0 (N/kg).
-    pub a1_pos: f64,
+    pub a_1_plus: f64,
     /// a_2^- ≤ 0 (N/kg²).
-    pub a2_neg: f64,
+    pub a_2_minus: f64,
     /// a_1^- ≤ 0 (N/kg).
-    pub a1_neg: f64,
+    pub a_1_minus: f64,
 }
 
 impl LoadDependence {
     pub fn validate(&self) -> Result<(), FrictionError> {
-        require("a2_pos", self.a2_pos, self.a2_pos >= 0.0, ">= 0 (Section 5.4)")?;
-        require("a1_pos", self.a1_pos, self.a1_pos >= 0.0, ">= 0 (Section 5.4)")?;
-        require("a2_neg", self.a2_neg, self.a2_neg <= 0.0, "<= 0 (Section 5.4)")?;
-        require("a1_neg", self.a1_neg, self.a1_neg <= 0.0, "<= 0 (Section 5.4)")
+        require("a_2_plus", self.a_2_plus, self.a_2_plus >= 0.0, ">= 0 (Section 5.4)")?;
+        require("a_1_plus", self.a_1_plus, self.a_1_plus >= 0.0, ">= 0 (Section 5.4)")?;
+        require("a_2_minus", self.a_2_minus, self.a_2_minus <= 0.0, "<= 0 (Section 5.4)")?;
+        require("a_1_minus", self.a_1_minus, self.a_1_minus <= 0.0, "<= 0 (Section 5.4)")
     }
 
     /// τ̃_f,d of the direction of q' for the foot load `load` (N) and its derivative with respect
@@ -326,7 +326,7 @@ impl LoadDependence {
         if load < 0.0 {
             return (a0, 0.0);
         }
-        let (a2, a1) = if positive(qd) { (self.a2_pos, self.a1_pos) } else { (self.a2_neg, self.a1_neg) };
+        let (a2, a1) = if positive(qd) { (self.a_2_plus, self.a_1_plus) } else { (self.a_2_minus, self.a_1_minus) };
         let x = load / LOAD_GRAVITY;
         ((a2 * x + a1) * x + a0, (2.0 * a2 * x + a1) / LOAD_GRAVITY)
     }
@@ -454,14 +454,14 @@ mod tests {
 
     /// Vertical joint of leg 0: Table 5.3 (dry, viscous) and Table 5.4 (stiction, 10 kg).
     fn vertical_leg0() -> LuGre {
-        let steady = SteadyState::Stribeck { tau_d_pos: 335.1, tau_d_neg: -423.6, tau_s_pos: 673.0, tau_s_neg: -679.5, qd_st: STRIBECK_VELOCITY };
+        let steady = SteadyState::Stribeck { tau_f_d_plus: 335.1, tau_f_d_minus: -423.6, tau_f_s_plus: 673.0, tau_f_s_minus: -679.5, qd_st: STRIBECK_VELOCITY };
         LuGre::new(steady, 3763.0, 8005.8).unwrap()
     }
 
     /// Horizontal joint of leg 0: Table 5.3 (viscous neglected, Section 6.1) and Table 5.5
     /// (a_1^- is not legible in the table: a made-up value of the right sign).
     fn horizontal_leg0_load() -> LoadDependence {
-        LoadDependence { a2_pos: 3.84, a1_pos: 20.3, a2_neg: -3.84, a1_neg: -15.0 }
+        LoadDependence { a_2_plus: 3.84, a_1_plus: 20.3, a_2_minus: -3.84, a_1_minus: -15.0 }
     }
 
     fn random_dry_viscous(r: &mut impl Rng) -> DryViscous {
@@ -469,17 +469,17 @@ mod tests {
     }
 
     fn random_lugre(r: &mut impl Rng, stribeck: bool) -> LuGre {
-        let (tau_d_pos, tau_d_neg) = (r.random_range(1.0..500.0), r.random_range(-500.0..-1.0));
+        let (tau_f_d_plus, tau_f_d_minus) = (r.random_range(1.0..500.0), r.random_range(-500.0..-1.0));
         let steady = if stribeck {
             SteadyState::Stribeck {
-                tau_d_pos,
-                tau_d_neg,
-                tau_s_pos: r.random_range(1.0..1500.0),
-                tau_s_neg: r.random_range(-1500.0..-1.0),
+                tau_f_d_plus,
+                tau_f_d_minus,
+                tau_f_s_plus: r.random_range(1.0..1500.0),
+                tau_f_s_minus: r.random_range(-1500.0..-1.0),
                 qd_st: r.random_range(1e-5..1e-3),
             }
         } else {
-            SteadyState::Dry { tau_d_pos, tau_d_neg }
+            SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }
         };
         let mut law = LuGre::new(steady, r.random_range(0.0..2e4), r.random_range(0.0..2e4)).unwrap();
         law.sigma_1 = r.random_range(0.0..1.0);
@@ -542,10 +542,10 @@ mod tests {
     #[test]
     fn negative_viscous_coefficients_are_forced_to_zero_and_signs_checked() {
         let law = DryViscous::new(465.1, -563.1, -4112.7, 247.5).unwrap();
-        assert_eq!(law.f_v_pos, 0.0);
+        assert_eq!(law.f_v_plus, 0.0);
         assert!(DryViscous::new(465.1, 563.1, 0.0, 0.0).is_err());
-        assert!(SteadyState::Dry { tau_d_pos: 7.7, tau_d_neg: 8.8 }.validate().is_err());
-        assert!(LoadDependence { a2_pos: 3.84, a1_pos: -1.0, a2_neg: -3.84, a1_neg: 0.0 }.validate().is_err());
+        assert!(SteadyState::Dry { tau_f_d_plus: 7.7, tau_f_d_minus: 8.8 }.validate().is_err());
+        assert!(LoadDependence { a_2_plus: 3.84, a_1_plus: -1.0, a_2_minus: -3.84, a_1_minus: 0.0 }.validate().is_err());
     }
 
     #[test]
@@ -599,7 +599,7 @@ mod tests {
     #[test]
     fn lugre_steady_state_reproduces_the_stribeck_curve() {
         let law = vertical_leg0();
-        let SteadyState::Stribeck { tau_d_pos, tau_d_neg, tau_s_pos, tau_s_neg, qd_st } = law.steady else { unreachable!() };
+        let SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st } = law.steady else { unreachable!() };
         for v in [1e-5, 5e-5, 1e-4, 2e-4, 5e-4, 1e-3, 8e-3, -1e-5, -5e-5, -1e-4, -2e-4, -5e-4, -1e-3, -8e-3] {
             // Explicit Euler on z' = -f_z(q', z, 0) with a step half the bristle time constant.
             let dt = 0.5 * law.g(v) / v.abs();
@@ -610,7 +610,7 @@ mod tests {
                 z += dt * zdot;
             }
             let tau = law.torque(v, z, zdot).0;
-            let (tau_d, tau_s, f_v) = if v >= 0.0 { (tau_d_pos, tau_s_pos, law.f_v_pos) } else { (tau_d_neg, tau_s_neg, law.f_v_neg) };
+            let (tau_d, tau_s, f_v) = if v >= 0.0 { (tau_f_d_plus, tau_f_s_plus, law.f_v_plus) } else { (tau_f_d_minus, tau_f_s_minus, law.f_v_minus) };
             let stribeck = tau_d + (tau_s - tau_d) * (-(v / qd_st).powi(2)).exp() + f_v * v; // Eq. 3.82
             assert!((tau - stribeck).abs() < 1e-9 * stribeck.abs(), "v = {v}: {tau} vs Eq. 3.82 {stribeck}");
             assert!((z - law.g(v) * v.signum()).abs() < 1e-12 * law.g(v), "Eq. 3.80 at v = {v}");
@@ -631,8 +631,8 @@ mod tests {
     #[test]
     fn lugre_is_dissipative_with_the_thesis_parameters() {
         let vertical = vertical_leg0();
-        let rotational = LuGre::new(SteadyState::Dry { tau_d_pos: 7.7, tau_d_neg: -8.8 }, 3.4, 22.3).unwrap();
-        let horizontal = LuGre::new(SteadyState::Dry { tau_d_pos: 465.1, tau_d_neg: -563.1 }, 0.0, 0.0).unwrap();
+        let rotational = LuGre::new(SteadyState::Dry { tau_f_d_plus: 7.7, tau_f_d_minus: -8.8 }, 3.4, 22.3).unwrap();
+        let horizontal = LuGre::new(SteadyState::Dry { tau_f_d_plus: 465.1, tau_f_d_minus: -563.1 }, 0.0, 0.0).unwrap();
         let mut constant_damping = vertical;
         constant_damping.v_d = f64::INFINITY;
         for law in [vertical, rotational, horizontal, constant_damping] {

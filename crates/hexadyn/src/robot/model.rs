@@ -16,11 +16,11 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::description::RobotDescription;
+use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Terrain};
-use crate::physics::{DryViscous, FrictionElement, JointFriction, LoadDependence, LuGre, SteadyState};
+use crate::physics::{DryViscous, FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
@@ -119,28 +119,27 @@ pub struct RobotModel {
 }
 
 fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
-    let p = d.friction(leg, joint);
+    // The description's parameters carry the thesis names of the laws' parameters.
+    let JointFrictionParameters {
+        tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, epsilon, load_dependence, ..
+    } = d.friction(leg, joint);
     let law = match options.friction {
         FrictionModel::None => JointFriction::None,
-        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus, f_v_pos: p.f_v_plus, f_v_neg: p.f_v_minus, epsilon: p.epsilon }),
+        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_f_d_plus, tau_f_d_minus, f_v_plus, f_v_minus, epsilon }),
         FrictionModel::LuGre => {
             // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
             // (horizontal, viscous effects neglected).
-            let (steady, f_v_pos, f_v_neg) = match (joint, p.q_st) {
-                (Joint::Vertical, Some(qd_st)) => (
-                    SteadyState::Stribeck { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus, tau_s_pos: p.tau_f_s_plus, tau_s_neg: p.tau_f_s_minus, qd_st },
-                    p.f_v_plus,
-                    p.f_v_minus,
-                ),
-                (Joint::Horizontal, _) => (SteadyState::Dry { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus }, 0.0, 0.0),
-                _ => (SteadyState::Dry { tau_d_pos: p.tau_f_d_plus, tau_d_neg: p.tau_f_d_minus }, p.f_v_plus, p.f_v_minus),
+            let (steady, f_v_plus, f_v_minus) = match (joint, q_st) {
+                (Joint::Vertical, Some(qd_st)) => (SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st }, f_v_plus, f_v_minus),
+                (Joint::Horizontal, _) => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, 0.0, 0.0),
+                _ => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, f_v_plus, f_v_minus),
             };
-            JointFriction::LuGre(LuGre { sigma_0: p.sigma_0, sigma_1: p.sigma_1, v_d: p.v_d, f_v_pos, f_v_neg, steady })
+            JointFriction::LuGre(LuGre { sigma_0, sigma_1, v_d, f_v_plus, f_v_minus, steady })
         }
     };
     let element = FrictionElement::new(law);
-    match (options.load_dependence, options.friction, p.load_dependence) {
-        (true, FrictionModel::DryViscous | FrictionModel::LuGre, Some(c)) => element.with_load(LoadDependence { a2_pos: c.a_2_plus, a1_pos: c.a_1_plus, a2_neg: c.a_2_minus, a1_neg: c.a_1_minus }),
+    match (options.load_dependence, options.friction, load_dependence) {
+        (true, FrictionModel::DryViscous | FrictionModel::LuGre, Some(load)) => element.with_load(load),
         _ => element,
     }
 }

@@ -50,7 +50,7 @@ use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, 
 use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
 use crate::control::{joint_pis, Command, Controller, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
-use crate::description::{Ctx, DescriptionError};
+use crate::fields::{Ctx, DescriptionError};
 use crate::description::RobotDescription;
 
 type Result<T> = std::result::Result<T, DescriptionError>;

@@ -20,7 +20,8 @@
 
 use serde::Deserialize;
 
-use crate::description::{Ctx, DescriptionError, Measured, PerLeg};
+use crate::description::{Measured, PerLeg};
+use crate::fields::{Ctx, DescriptionError};
 use crate::description::RobotDescription;
 use crate::hexapod::Joint;
 

@@ -117,7 +117,8 @@ use std::time::Instant;
 
 use serde::Deserialize;
 
-use crate::description::{Ctx, DescriptionError, FieldError, RobotDescription, SpanIndex, AMRU5_TOML};
+use crate::description::{RobotDescription, AMRU5_TOML};
+use crate::fields::{Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel};
 use crate::robot::recorder::{Recorder, TimeSeries};

@@ -7,7 +7,7 @@
 //! overrides), so a results folder always holds the scenario that actually ran.
 
 use super::{ScenarioError, REFERENCE};
-use crate::description::{FieldError, SpanIndex};
+use crate::fields::{FieldError, SpanIndex};
 
 /// One field set from outside the scenario file.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,0 +1,145 @@
+//! Fields of the TOML input files (the robot description, [`crate::description`], and the
+//! scenario files, [`crate::scenario`]): where each field stands in the file, how a bad field
+//! is reported, and the bounds a single field declares.
+//!
+//! Every error names the file, the line when it is known, the dotted field path, the value as
+//! read and what is allowed:
+//!
+//! ```text
+//! robots/amru5.toml:179: field `motor.resistance_ohm` = -0.334: out of range; allowed: a finite number > 0
+//! ```
+//!
+//! A field whose constraint involves only itself declares it with its type in the file mirror,
+//! `#[serde(deserialize_with = "Positive::checked")]`, and is checked while deserializing
+//! (`Bound`); the span index turns that error into the line and path of the field
+//! (`SpanIndex::serde_error`). Relations between fields are checked after deserializing with
+//! a `Ctx`, which names the field path itself.
+
+use std::fmt;
+
+mod bounded;
+mod span_index;
+
+pub(crate) use bounded::{bounds, seq, Bound, Finite, NonNegative, Positive, Value, Violation};
+pub(crate) use span_index::SpanIndex;
+
+/// An input file (robot description or scenario) that could not be read, parsed or validated.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DescriptionError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the robot description: {reason}")]
+    Io { file: String, reason: String },
+    /// The text is not valid TOML.
+    #[error("{file}:{line}:{column}: TOML syntax error: {message}")]
+    Syntax { file: String, line: usize, column: usize, message: String },
+    /// A field is missing, unknown, of the wrong type or out of its allowed range.
+    #[error("{0}")]
+    Field(Box<FieldError>),
+}
+
+/// The details of a [`DescriptionError::Field`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldError {
+    pub file: String,
+    /// 1-based line of the field in the file, when known.
+    pub line: Option<usize>,
+    /// Dotted path, e.g. `motor.resistance_ohm` or `legs[2].angle_deg`.
+    pub field: String,
+    /// The offending value as written (or `<missing>`).
+    pub value: String,
+    /// What is wrong (`out of range`, `unknown field`, `missing field`, `invalid type`...).
+    pub problem: String,
+    /// What would be accepted.
+    pub allowed: String,
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(l) = self.line {
+            write!(f, ":{l}")?;
+        }
+        write!(f, ": field `{}` = {}: {}; allowed: {}", self.field, self.value, self.problem, self.allowed)
+    }
+}
+
+impl DescriptionError {
+    pub(crate) fn field_error(
+        file: &str,
+        line: Option<usize>,
+        field: String,
+        value: String,
+        problem: String,
+        allowed: String,
+    ) -> Self {
+        DescriptionError::Field(Box::new(FieldError { file: file.to_string(), line, field, value, problem, allowed }))
+    }
+
+    /// The file (or origin name) the error refers to.
+    pub fn file(&self) -> &str {
+        match self {
+            DescriptionError::Io { file, .. } | DescriptionError::Syntax { file, .. } => file,
+            DescriptionError::Field(e) => &e.file,
+        }
+    }
+
+    /// The dotted field path, for field errors.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            DescriptionError::Field(e) => Some(&e.field),
+            _ => None,
+        }
+    }
+}
+
+pub(crate) type Result<T> = std::result::Result<T, DescriptionError>;
+
+/// The checks of one file after deserializing: errors name `file` and, with an index, the line
+/// of the field.
+pub(crate) struct Ctx<'a> {
+    pub(crate) file: &'a str,
+    pub(crate) index: Option<&'a SpanIndex<'a>>,
+}
+
+impl Ctx<'_> {
+    /// The error of the field at the dotted path `field`.
+    pub(crate) fn err(&self, field: &str, value: impl fmt::Display, problem: &str, allowed: impl Into<String>) -> DescriptionError {
+        DescriptionError::field_error(
+            self.file,
+            self.index.and_then(|i| i.line_of(field)),
+            field.to_string(),
+            value.to_string(),
+            problem.to_string(),
+            allowed.into(),
+        )
+    }
+
+    /// `ok` for a finite `value`: "not a finite number" or "out of range" otherwise.
+    pub(crate) fn check(&self, ok: bool, field: &str, value: f64, allowed: &str) -> Result<()> {
+        if !value.is_finite() {
+            return Err(self.err(field, value, "not a finite number", allowed));
+        }
+        if ok {
+            Ok(())
+        } else {
+            Err(self.err(field, value, "out of range", allowed))
+        }
+    }
+
+    /// `value` within the bound `B`, with the error a bounded field of the file gets.
+    pub(crate) fn bounded<B: Bound>(&self, field: &str, value: f64) -> Result<()> {
+        self.check(B::holds(value), field, value, B::ALLOWED)
+    }
+
+    pub(crate) fn finite(&self, field: &str, v: f64) -> Result<()> {
+        self.bounded::<Finite>(field, v)
+    }
+
+    pub(crate) fn positive(&self, field: &str, v: f64) -> Result<()> {
+        self.bounded::<Positive>(field, v)
+    }
+
+    pub(crate) fn non_negative(&self, field: &str, v: f64) -> Result<()> {
+        self.bounded::<NonNegative>(field, v)
+    }
+}
