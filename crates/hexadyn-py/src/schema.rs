@@ -6,7 +6,6 @@
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::description::RobotDescription;
 use hexadyn::hexapod::{Joint, LEG_COUNT};
-use hexadyn::scenario::phase_code;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -21,7 +20,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let phases = PyDict::new(py);
     for phase in FootPhase::ALL {
         // The codes are small integers stored as floats in the time series.
-        phases.set_item(phase.name(), phase_code(phase) as u8)?;
+        phases.set_item(phase.name(), phase.code() as u8)?;
     }
     m.add("PHASE_CODES", phases)?;
     m.add_function(wrap_pyfunction!(robot_properties, m)?)?;

@@ -1,5 +1,5 @@
 //! The relations between fields of a description, checked after reading it (each field's own
-//! range is declared in [`super::file`] and checked while reading): the legs, the pantograph
+//! range is declared in [`super::tables`] and checked while reading): the legs, the pantograph
 //! closure, the principal moments and masses of Table B.2, the reduction products of
 //! Table 3.1, the ranges and the friction tables.
 

@@ -3,8 +3,8 @@
 //! A [`Recorder`] fills a [`TimeSeries`] row by row. The first row defines the columns (name,
 //! unit, description); every later row must put the same columns in the same order, which
 //! [`Recorder::end_row`] checks. The names follow the thesis symbols with the joint or foot
-//! index in brackets: `q_v[2]`, `i_q_v[2]`, `tau_f_q_v[2]`, `Fz[2]` (see
-//! [`crate::scenario`] for the full list).
+//! index in brackets: `q_v[2]`, `i_q_v[2]`, `tau_f_q_v[2]`, `Fz[2]` (see [`super::columns`]
+//! for the full list).
 
 use std::fmt;
 

@@ -1,41 +1,10 @@
 //! `[control] mode = "gait"`: walking scenarios (thesis Chapter 7; the validation case of
-//! Section 6.3, Table 6.2). The `[gait]` table is validated into a [`GaitScenario`]; at run time
-//! a [`ScheduledGait`] drives the [`GaitController`] (applying the `[[gait.change]]` entries) and
-//! leaves what it did at each update in a shared [`GaitState`] that the recorder reads.
-//!
-//! ```toml
-//! [control]
-//! mode = "gait"
-//!
-//! [gait]
-//! period_s = 12.0              # leg cycle time T (s)
-//! pattern = "tripod"           # "tripod" | "wave" | "equal_phase"
-//! duty_factor = 0.75           # β, wave and equal_phase only (default 0.75; tripod is 0.5)
-//! cycle = "enhanced"           # "enhanced" (Section 7.6, default) | "plain" (Fig. 7.12)
-//! overlap = 0.05               # Δφ of the enhanced cycle (default 0.05, Table 6.2)
-//! aep = "periodic"             # "periodic" (Eq. 7.24-7.31, default) | "omnidirectional" (7.5.2)
-//! clearance_m = 0.045          # foot clearance at mid-swing (default 0.045 m)
-//! navigation = false           # the controller receives the true body pose (Section 7.4)
-//! body_height_m = 0.36         # optional; default: the height with q_v = 0.06 m, q_h = 0.035 m
-//!
-//! [gait.heading]               # heading velocities (V_x, V_y, Ω_z), global frame
-//! kind = "constant"            # vx_m_s, vy_m_s, omega_z_rad_s (each default 0)
-//!                              # "csv": file (t,vx,vy,omega_z; relative to the scenario)
-//!                              # "back_and_forth": Section 7.5.3 (0.015 m/s, -0.02 from 140 s)
-//!                              # "square": side_m, speed_m_s (straight lines, 90° turns)
-//!                              # "spline": t_s, x_m, y_m waypoints, or none for the built-in
-//!                              #   path of Section 7.5.3; yaw tangent to the path
-//!
-//! [[gait.change]]              # any number, at increasing times: a gait change while walking
-//! at_s = 20.0
-//! pattern = "wave"
-//! duty_factor = 0.75
-//! ```
-//!
-//! The initial posture is not taken from `[initial]` (its joint fields are rejected in gait
-//! mode): every foot starts at its workspace centre at the body height, joints from the inverse
-//! kinematics. `[initial].settle` (static equilibrium with the joints locked) and
-//! `body_height_offset_m` still apply.
+//! Section 6.3, Table 6.2). The `[gait]` table (format: `docs/scenario-format.md`) is mirrored
+//! and validated into a [`GaitScenario`]: the patterns and the foot cycle, the leg kinematics
+//! and the workspace cylinders at the body height, the initial joints (every foot at its
+//! steady foothold for its initial phase) and the heading source, with every support stroke checked against the
+//! workspace. At run time [`GaitScenario::controller`] gives the gait controller with its
+//! schedule of gait changes ([`crate::control::gait::schedule`]).
 
 use std::cell::RefCell;
 use std::path::Path;
@@ -44,11 +13,11 @@ use std::rc::Rc;
 use nalgebra::Vector3;
 use serde::Deserialize;
 
-use crate::control::gait::body_motion::Pose;
-use crate::control::gait::controller::{joints_at, steady_footholds, AepMode, GaitController, GaitDiagnostics, GaitOptions};
+use crate::control::gait::controller::{joints_at, steady_footholds, AepMode, GaitController, GaitOptions};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
-use crate::control::gait::pattern::{FootCycle, FootPhase, GaitKind, GaitPattern};
-use crate::control::{joint_pis, Command, Controller, Measurements};
+use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
+use crate::control::gait::schedule::{GaitChange, GaitState, ScheduledGait};
+use crate::control::joint_pis;
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::RobotDescription;
@@ -183,14 +152,6 @@ impl HeadingSpec {
     }
 }
 
-/// A gait change while walking: at `at` (s) the controller is asked for `pattern`
-/// ([`GaitController::change_gait`]); it switches once all six feet are down.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GaitChange {
-    pub at: f64,
-    pub pattern: GaitPattern,
-}
-
 /// The validated `[gait]` table, SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GaitScenario {
@@ -204,20 +165,24 @@ pub struct GaitScenario {
     pub legs: [LegKinematics; 6],
     pub workspaces: [Workspace; 6],
     pub changes: Vec<GaitChange>,
-    /// The initial posture: the workspace centres at the ground, by inverse kinematics.
+    /// The initial posture: the steady footholds of the initial phases on the ground, by
+    /// inverse kinematics.
     pub joints: [f64; JOINTS],
+}
+
+impl GaitScenario {
+    /// A fresh gait controller for a run, with the scheduled gait changes and the 18 PI loops of
+    /// the robot, and the state it publishes after each update.
+    pub fn controller(&self, robot: &RobotDescription) -> (ScheduledGait, Rc<RefCell<GaitState>>) {
+        let pis = joint_pis(robot, self.options.dt);
+        let controller = GaitController::new(self.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source());
+        ScheduledGait::new(controller, self.changes.clone())
+    }
 }
 
 /// The body height with q_v = 0.06 m (the default of `gait.body_height_m`).
 pub fn default_body_height(legs: &[LegKinematics; 6]) -> f64 {
     -legs[0].foot(&Vector3::from(DEFAULT_POSTURE)).z
-}
-
-fn cycle_name(c: FootCycle) -> &'static str {
-    match c {
-        FootCycle::Plain => "plain",
-        FootCycle::Enhanced { .. } => "enhanced",
-    }
 }
 
 fn kind_name(k: GaitKind) -> &'static str {
@@ -469,164 +434,4 @@ fn validate_heading(h: &RawHeading, c: &Ctx, dir: &Path) -> Result<HeadingSpec> 
             }
         },
     })
-}
-
-// =============================================================================================
-// Running
-// =============================================================================================
-
-/// Phase code of a foot for gait diagrams: 0 support, 1 takeoff, 2 swing, 3 landing.
-pub fn phase_code(p: FootPhase) -> f64 {
-    match p {
-        FootPhase::Support => 0.0,
-        FootPhase::Takeoff => 1.0,
-        FootPhase::Swing => 2.0,
-        FootPhase::Landing => 3.0,
-    }
-}
-
-/// What the gait controller did at its last update.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub(super) struct GaitState {
-    /// Desired body pose T*_{0,b}, its linear velocity and angular velocity (global).
-    pub pose: Pose,
-    pub velocity: Vector3<f64>,
-    pub omega: Vector3<f64>,
-    /// Phase codes ([`phase_code`]).
-    pub phases: [f64; 6],
-    /// Foot references in the leg frames.
-    pub feet: [Vector3<f64>; 6],
-    /// Duty factor of the current pattern.
-    pub beta: f64,
-    pub diagnostics: GaitDiagnostics,
-}
-
-/// The gait controller with the scheduled gait changes, publishing its state after each update.
-pub(super) struct ScheduledGait {
-    controller: GaitController,
-    changes: Vec<GaitChange>,
-    next: usize,
-    state: Rc<RefCell<GaitState>>,
-}
-
-impl ScheduledGait {
-    pub(super) fn new(g: &GaitScenario, robot: &RobotDescription) -> (Self, Rc<RefCell<GaitState>>) {
-        let dt = g.options.dt;
-        let pis = joint_pis(robot, dt);
-        let controller = GaitController::new(g.options.clone(), g.legs.clone(), g.workspaces, pis, g.heading.source());
-        let state = Rc::new(RefCell::new(GaitState::default()));
-        (ScheduledGait { controller, changes: g.changes.clone(), next: 0, state: state.clone() }, state)
-    }
-}
-
-impl Controller for ScheduledGait {
-    fn update(&mut self, m: &Measurements) -> Command {
-        let half = 0.5 * self.controller.options.dt;
-        while let Some(change) = self.changes.get(self.next).filter(|ch| m.t >= ch.at - half) {
-            self.controller.change_gait(change.pattern.clone());
-            self.next += 1;
-        }
-        let command = self.controller.update(m);
-        let c = &self.controller;
-        let (velocity, omega) = c.desired_velocity().unwrap_or_default();
-        *self.state.borrow_mut() = GaitState {
-            pose: c.desired_pose().unwrap_or_default(),
-            velocity,
-            omega,
-            phases: c.phases().map(phase_code),
-            feet: c.foot_references(),
-            beta: c.options.pattern.beta,
-            diagnostics: c.diagnostics,
-        };
-        command
-    }
-}
-
-/// Gait figures of a run, accumulated row by row.
-#[derive(Clone, Debug)]
-pub(super) struct GaitStats {
-    pub max_xy_error: f64,
-    pub final_xy_error: f64,
-    pub max_yaw_error: f64,
-    pub distance: f64,
-    pub reference_distance: f64,
-    last: Option<([f64; 2], [f64; 2])>,
-    pub min_feet: usize,
-    pub max_outside: f64,
-}
-
-impl Default for GaitStats {
-    fn default() -> Self {
-        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0 }
-    }
-}
-
-impl GaitStats {
-    /// One control instant: body pose `q` (X, Y, Z, yaw, ...), the gait state, feet on the
-    /// ground and the workspaces.
-    pub(super) fn observe(&mut self, q: &[f64], s: &GaitState, feet_down: usize, workspaces: &[Workspace; 6]) {
-        let actual = [q[0], q[1]];
-        let desired = [s.pose.position.x, s.pose.position.y];
-        let e = (actual[0] - desired[0]).hypot(actual[1] - desired[1]);
-        self.max_xy_error = self.max_xy_error.max(e);
-        self.final_xy_error = e;
-        let yaw = (q[3] - s.pose.angles.x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-        self.max_yaw_error = self.max_yaw_error.max(yaw.abs());
-        if let Some((a, d)) = self.last {
-            self.distance += (actual[0] - a[0]).hypot(actual[1] - a[1]);
-            self.reference_distance += (desired[0] - d[0]).hypot(desired[1] - d[1]);
-        }
-        self.last = Some((actual, desired));
-        self.min_feet = self.min_feet.min(feet_down);
-        for (w, f) in workspaces.iter().zip(&s.feet) {
-            self.max_outside = self.max_outside.max(w.distance_outside(f));
-        }
-    }
-}
-
-/// The gait part of a run's summary.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GaitSummary {
-    /// Initial pattern name, foot cycle and heading kind.
-    pub pattern: String,
-    pub cycle: &'static str,
-    pub heading: &'static str,
-    pub navigation: bool,
-    /// |(X, Y) − (X*, Y*)|: largest over the run and at the end (m).
-    pub tracking_error_xy_max_m: f64,
-    pub tracking_error_xy_final_m: f64,
-    /// Largest |yaw − yaw*| (rad).
-    pub tracking_error_yaw_max_rad: f64,
-    /// Path length of the body centre (X, Y) and of its reference, sampled at the control
-    /// instants (m).
-    pub distance_walked_m: f64,
-    pub reference_distance_m: f64,
-    /// Foot references the inverse kinematics clamped into the joint ranges (count of leg
-    /// updates).
-    pub clamped_ik_references: u64,
-    pub gait_switches: u64,
-    /// Fewest feet with a normal force > 0 at a control instant.
-    pub min_feet_on_ground: u64,
-    /// Largest distance of a foot reference outside its workspace cylinder (m).
-    pub max_foot_reference_outside_workspace_m: f64,
-}
-
-impl GaitSummary {
-    pub(super) fn new(g: &GaitScenario, stats: &GaitStats, diagnostics: &GaitDiagnostics) -> Self {
-        GaitSummary {
-            pattern: g.options.pattern.name.clone(),
-            cycle: cycle_name(g.options.cycle),
-            heading: g.heading.kind(),
-            navigation: g.navigation,
-            tracking_error_xy_max_m: stats.max_xy_error,
-            tracking_error_xy_final_m: stats.final_xy_error,
-            tracking_error_yaw_max_rad: stats.max_yaw_error,
-            distance_walked_m: stats.distance,
-            reference_distance_m: stats.reference_distance,
-            clamped_ik_references: diagnostics.clamped_references as u64,
-            gait_switches: diagnostics.gait_switches as u64,
-            min_feet_on_ground: stats.min_feet as u64,
-            max_foot_reference_outside_workspace_m: stats.max_outside,
-        }
-    }
 }

@@ -2,17 +2,7 @@
 //! per-leg identification (Tables 5.3 and 5.5) in one scenario — the averaged friction of the
 //! Monte Carlo runs of Section 6.5 (Table 6.7), or a what-if study.
 //!
-//! ```toml
-//! [model.joint_friction.q_r]     # Nm and Nm s/rad; every key optional
-//! tau_f_d_plus = 8.04            # tau_f_d^+ >= 0 (Eq. 6.1)
-//! f_v_plus = 3.46                # f_v^+ >= 0
-//! tau_f_d_minus = -8.97          # tau_f_d^- <= 0
-//! f_v_minus = 16.17              # f_v^- >= 0 (a slope, like Table 5.3)
-//! [model.joint_friction.q_v]     # N and N s/m; the same four keys
-//! [model.joint_friction.q_h]     # N and N s/m; the four keys and the load dependence of
-//! a_2_plus = 5.5                 # Eq. 5.12 (Table 5.5, load in kg): a_2^+ >= 0 (N/kg^2),
-//! a_1_plus = 20.0                # a_1^+ >= 0 (N/kg), a_2^- <= 0, a_1^- <= 0
-//! ```
+//! The keys, units and signs are documented with the file format in `docs/scenario-format.md`.
 //!
 //! Keys left out keep the robot's per-leg values. The signs are those of a physical friction
 //! (a dry friction opposes the motion and grows with the load; a viscous slope is not negative),
@@ -20,9 +10,8 @@
 
 use serde::Deserialize;
 
-use crate::description::{Measured, PerLeg};
+use crate::description::{Measured, PerLeg, RobotDescription};
 use crate::fields::{Ctx, DescriptionError};
-use crate::description::RobotDescription;
 use crate::hexapod::Joint;
 
 /// The raw `[model.joint_friction]` table.

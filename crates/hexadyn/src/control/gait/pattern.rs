@@ -85,6 +85,12 @@ impl FootPhase {
         }
     }
 
+    /// Phase code of the `phase[l]` columns and gait diagrams: the index in [`FootPhase::ALL`]
+    /// (0 support, 1 takeoff, 2 swing, 3 landing).
+    pub fn code(self) -> f64 {
+        FootPhase::ALL.iter().position(|&p| p == self).expect("every phase is in ALL") as f64
+    }
+
     pub fn on_ground(self) -> bool {
         self == FootPhase::Support
     }

@@ -1,0 +1,77 @@
+//! A gait schedule (thesis Sections 7.1.2, 7.2.4): the [`GaitController`] with gait changes
+//! requested at given times ([`ScheduledGait`]), publishing what it did at each update in a
+//! shared [`GaitState`] (desired body pose and velocities, foot phases and references,
+//! diagnostics) that a recorder or a summary reads without reaching into the controller.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use nalgebra::Vector3;
+
+use super::body_motion::Pose;
+use super::controller::{GaitController, GaitDiagnostics};
+use super::pattern::{FootPhase, GaitPattern};
+use crate::control::{Command, Controller, Measurements};
+
+/// A gait change while walking: at `at` (s) the controller is asked for `pattern`
+/// ([`GaitController::change_gait`]); it switches once all six feet are down.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GaitChange {
+    pub at: f64,
+    pub pattern: GaitPattern,
+}
+
+/// What the gait controller did at its last update.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GaitState {
+    /// Desired body pose T*_{0,b}, its linear velocity and angular velocity (global).
+    pub pose: Pose,
+    pub velocity: Vector3<f64>,
+    pub omega: Vector3<f64>,
+    /// Phase codes ([`FootPhase::code`]).
+    pub phases: [f64; 6],
+    /// Foot references in the leg frames.
+    pub feet: [Vector3<f64>; 6],
+    /// Duty factor of the current pattern.
+    pub beta: f64,
+    pub diagnostics: GaitDiagnostics,
+}
+
+/// The gait controller with the scheduled gait changes, publishing its state after each update.
+pub struct ScheduledGait {
+    controller: GaitController,
+    changes: Vec<GaitChange>,
+    next: usize,
+    state: Rc<RefCell<GaitState>>,
+}
+
+impl ScheduledGait {
+    /// `changes` at increasing times; returns the controller and the state it publishes.
+    pub fn new(controller: GaitController, changes: Vec<GaitChange>) -> (Self, Rc<RefCell<GaitState>>) {
+        let state = Rc::new(RefCell::new(GaitState::default()));
+        (ScheduledGait { controller, changes, next: 0, state: state.clone() }, state)
+    }
+}
+
+impl Controller for ScheduledGait {
+    fn update(&mut self, m: &Measurements) -> Command {
+        let half = 0.5 * self.controller.options.dt;
+        while let Some(change) = self.changes.get(self.next).filter(|ch| m.t >= ch.at - half) {
+            self.controller.change_gait(change.pattern.clone());
+            self.next += 1;
+        }
+        let command = self.controller.update(m);
+        let c = &self.controller;
+        let (velocity, omega) = c.desired_velocity().unwrap_or_default();
+        *self.state.borrow_mut() = GaitState {
+            pose: c.desired_pose().unwrap_or_default(),
+            velocity,
+            omega,
+            phases: c.phases().map(FootPhase::code),
+            feet: c.foot_references(),
+            beta: c.options.pattern.beta,
+            diagnostics: c.diagnostics,
+        };
+        command
+    }
+}

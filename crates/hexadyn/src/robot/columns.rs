@@ -1,0 +1,167 @@
+//! The columns a run of the simulated robot records: one row per control instant (the start
+//! and the end included), filled into a [`Recorder`] by [`record_row`].
+//!
+//! Each row holds the state at that instant t; the electrical columns (`u_*`, `i_*`, `tau_m_*`)
+//! are those of the voltage held during the control period that ends at t — what the current
+//! sensors read at t —, the references (`q_*_ref`) those the controller computed at t. The
+//! names follow the thesis symbols with the leg (i, l) or foot (f) number 0..5 in brackets:
+//! `q_v[2]` is the q_v joint of leg 2.
+//!
+//! | columns | unit | |
+//! | --- | --- | --- |
+//! | `t` | s | control instant |
+//! | `X`, `Y`, `Z`; `yaw`, `pitch`, `roll` | m; rad | body pose (Eq. 3.51-3.52) |
+//! | `X_dot` ... `roll_dot` | m/s; rad/s | body velocities |
+//! | `q_r[i]`, `q_v[i]`, `q_h[i]` | rad, m, m | joints of leg i |
+//! | `q_r_dot[i]` ... | rad/s, m/s | joint velocities |
+//! | `q_r_ref[i]` ... | rad, m | joint references (modes `pi` and `gait`) |
+//! | `X_ref`, `Y_ref`, `Z_ref`; `yaw_ref`, `pitch_ref`, `roll_ref` | m; rad | desired body pose T*_{0,b} (gait) |
+//! | `X_dot_ref`, `Y_dot_ref`; `omega_z_ref` | m/s; rad/s | commanded heading velocities (gait) |
+//! | `duty_factor` | 1 | β of the current gait pattern (gait) |
+//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing (gait) |
+//! | `foot_ref_x[l]`, `foot_ref_y[l]`, `foot_ref_z[l]` | m | foot reference in the leg frame (gait) |
+//! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
+//! | `i_q_v[i]` ... | A | motor current |
+//! | `tau_m_q_v[i]` ... | Nm (q_r), N | motor torque at the joint, n k_t i |
+//! | `tau_f_q_v[i]` ... | Nm (q_r), N | joint friction torque |
+//! | `z_q_v[i]` ... | rad (q_r), m | LuGre bristle deflection (friction `lugre` only) |
+//! | `Fx[f]`, `Fy[f]`, `Fz[f]`, `Fn[f]` | N | ground force on foot f (global frame), normal part |
+//! | `penetration[f]` | m | δ: > 0 in the ground, < 0 the clearance |
+//! | `foot_x[f]`, `foot_y[f]`, `foot_z[f]` | m | foot position (global frame) |
+//! | `E_el_q_v[i]`, `E_joule_q_v[i]`, `E_fric_q_v[i]` ... | J | cumulative electrical energy ∫u i dt, Joule losses, friction work ∫τ_f q' dt |
+//! | `E_kin`, `E_pot` | J | kinetic and gravitational potential energy |
+//! | `E_contact`, `E_stored`, `E_balance` | J | cumulative work on the ground; energy in bristles, ground springs and inductances; energy balance error |
+//!
+//! The columns marked (gait) are those of the [`GaitState`] the gait controller publishes; the
+//! references and the bristles are recorded when [`ColumnGroups`] says so. Each column also
+//! carries a one-line description ([`crate::robot::recorder::Column`]).
+
+use super::recorder::Recorder;
+use super::simulation::SimulatedRobot;
+use crate::control::gait::schedule::GaitState;
+use crate::control::{Command, Measurements};
+use crate::hexapod::{Joint, JOINTS};
+
+/// The optional column groups of a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ColumnGroups {
+    /// `q_*_ref[i]`: the joint references the controller computed (joint PI and gait control).
+    pub references: bool,
+    /// `z_*[i]`: the LuGre bristle deflections (friction `lugre`).
+    pub bristles: bool,
+}
+
+/// Records the row of control instant `meas.t`: the robot `p` after the period, the command
+/// `cmd` the controller computed at t and, walking, the state the gait controller published.
+pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: &Command, groups: ColumnGroups, gait: Option<&GaitState>) {
+    let st = p.state();
+    let (q, qd) = (st.q.as_slice(), st.qd.as_slice());
+    let out = &p.robot.outputs;
+    let e = &p.energy;
+    let s = |x: &str| x.to_string();
+    rec.begin_row();
+    rec.put(meas.t, || (s("t"), "s", s("control instant")));
+    const BODY: [(&str, &str, &str); 6] = [("X", "m", "body centre x"), ("Y", "m", "body centre y"), ("Z", "m", "body centre height"), ("yaw", "rad", "body yaw"), ("pitch", "rad", "body pitch"), ("roll", "rad", "body roll")];
+    for (i, (n, u, d)) in BODY.iter().enumerate() {
+        rec.put(q[i], || (s(n), u, s(d)));
+    }
+    const BODY_DOT: [(&str, &str); 6] = [("X_dot", "m/s"), ("Y_dot", "m/s"), ("Z_dot", "m/s"), ("yaw_dot", "rad/s"), ("pitch_dot", "rad/s"), ("roll_dot", "rad/s")];
+    for (i, (n, u)) in BODY_DOT.iter().enumerate() {
+        rec.put(qd[i], || (s(n), u, format!("time derivative of {}", &n[..n.len() - 4])));
+    }
+    for k in 0..JOINTS {
+        rec.put(q[6 + k], || (joint_name("", k, ""), joint_unit(k, ("rad", "m")), format!("joint position, leg {}", k / 3)));
+    }
+    for k in 0..JOINTS {
+        rec.put(qd[6 + k], || (joint_name("", k, "_dot"), joint_unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
+    }
+    if groups.references {
+        for k in 0..JOINTS {
+            rec.put(cmd.references[k], || (joint_name("", k, "_ref"), joint_unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
+        }
+    }
+    if let Some(g) = gait {
+        record_gait(rec, g);
+    }
+    for k in 0..JOINTS {
+        rec.put(out.voltage[k], || (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
+    }
+    for k in 0..JOINTS {
+        rec.put(out.current[k], || (joint_name("i_", k, ""), "A", s("motor current")));
+    }
+    for k in 0..JOINTS {
+        rec.put(out.motor_torque[k], || (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
+    }
+    for k in 0..JOINTS {
+        rec.put(out.friction_torque[k], || (joint_name("tau_f_", k, ""), joint_unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
+    }
+    if groups.bristles {
+        for k in 0..JOINTS {
+            rec.put(out.bristle[k], || (joint_name("z_", k, ""), joint_unit(k, ("rad", "m")), s("LuGre bristle deflection")));
+        }
+    }
+    for (f, c) in out.contact.iter().enumerate() {
+        rec.put(c.force.x, || (format!("Fx[{f}]"), "N", s("ground force on the foot, x (global)")));
+        rec.put(c.force.y, || (format!("Fy[{f}]"), "N", s("ground force on the foot, y (global)")));
+        rec.put(c.force.z, || (format!("Fz[{f}]"), "N", s("ground force on the foot, z (global)")));
+        rec.put(c.normal_force, || (format!("Fn[{f}]"), "N", s("normal ground force on the foot")));
+        rec.put(c.penetration, || (format!("penetration[{f}]"), "m", s("foot penetration into the ground (< 0: clearance)")));
+    }
+    for (f, x) in out.foot.iter().enumerate() {
+        rec.put(x.x, || (format!("foot_x[{f}]"), "m", s("foot position x (global)")));
+        rec.put(x.y, || (format!("foot_y[{f}]"), "m", s("foot position y (global)")));
+        rec.put(x.z, || (format!("foot_z[{f}]"), "m", s("foot position z (global)")));
+    }
+    for k in 0..JOINTS {
+        rec.put(e.electrical[k], || (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy drawn, integral of u i")));
+    }
+    for k in 0..JOINTS {
+        rec.put(e.joule[k], || (joint_name("E_joule_", k, ""), "J", s("cumulative Joule losses in motor and H-bridge")));
+    }
+    for k in 0..JOINTS {
+        rec.put(e.friction_work[k], || (joint_name("E_fric_", k, ""), "J", s("cumulative work against joint friction, integral of tau_f q'")));
+    }
+    rec.put(e.kinetic, || (s("E_kin"), "J", s("kinetic energy")));
+    rec.put(e.potential, || (s("E_pot"), "J", s("gravitational potential energy")));
+    rec.put(e.contact_work.iter().sum(), || (s("E_contact"), "J", s("cumulative work of the feet on the ground")));
+    rec.put(e.bristle_energy + e.contact_energy + e.magnetic_energy, || (s("E_stored"), "J", s("energy stored in bristles, ground springs and inductances")));
+    rec.put(e.balance_error(&p.initial_energy), || (s("E_balance"), "J", s("energy balance error so far (electrical in minus what it became)")));
+    rec.end_row();
+}
+
+/// The gait controller's columns: desired body pose and velocities, duty factor, foot phases
+/// and foot references.
+fn record_gait(rec: &mut Recorder, g: &GaitState) {
+    let s = |x: &str| x.to_string();
+    let pose = [g.pose.position.x, g.pose.position.y, g.pose.position.z, g.pose.angles.x, g.pose.angles.y, g.pose.angles.z];
+    const POSE: [(&str, &str); 6] = [("X_ref", "m"), ("Y_ref", "m"), ("Z_ref", "m"), ("yaw_ref", "rad"), ("pitch_ref", "rad"), ("roll_ref", "rad")];
+    for ((n, u), v) in POSE.iter().zip(pose) {
+        rec.put(v, || (s(n), u, format!("desired body pose {} (T*_0,b, Eq. 7.12-7.23)", &n[..n.len() - 4])));
+    }
+    rec.put(g.velocity.x, || (s("X_dot_ref"), "m/s", s("commanded heading velocity V_x (global)")));
+    rec.put(g.velocity.y, || (s("Y_dot_ref"), "m/s", s("commanded heading velocity V_y (global)")));
+    rec.put(g.omega.z, || (s("omega_z_ref"), "rad/s", s("commanded yaw rate Omega_z")));
+    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern")));
+    for (l, phase) in g.phases.iter().enumerate() {
+        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing")));
+    }
+    for (l, f) in g.feet.iter().enumerate() {
+        rec.put(f.x, || (format!("foot_ref_x[{l}]"), "m", s("foot reference x, leg frame")));
+        rec.put(f.y, || (format!("foot_ref_y[{l}]"), "m", s("foot reference y, leg frame")));
+        rec.put(f.z, || (format!("foot_ref_z[{l}]"), "m", s("foot reference z, leg frame")));
+    }
+}
+
+/// Unit of a joint quantity: (rotational, translational).
+fn joint_unit(k: usize, units: (&'static str, &'static str)) -> &'static str {
+    if Joint::ALL[k % 3].is_rotational() {
+        units.0
+    } else {
+        units.1
+    }
+}
+
+/// `q_v[2]` style name of joint k with a prefix and suffix: `{prefix}q_v{suffix}[2]`.
+fn joint_name(prefix: &str, k: usize, suffix: &str) -> String {
+    format!("{prefix}{}{suffix}[{}]", Joint::ALL[k % 3].symbol(), k / 3)
+}

@@ -1,0 +1,449 @@
+//! The scenario file: the raw serde mirror of its tables with their defaults, and its
+//! validation into a [`Scenario`]: the robot it names, the model, integrator and
+//! initial-configuration options, the control mode and the joint motions, each value checked
+//! against what the robot description allows (joint ranges, control period). Unknown keys are
+//! errors (`deny_unknown_fields`). The `[gait]` and `[model.joint_friction]` tables are mirrored
+//! and validated in their own submodules ([`super::gait`], [`super::joint_friction`]). The
+//! format is documented in `docs/scenario-format.md`.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use super::gait::{self, RawGait};
+use super::joint_friction::RawJointFriction;
+use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
+use crate::control::JointMotion;
+use crate::description::{RobotDescription, AMRU5_TOML};
+use crate::fields::{Ctx, DescriptionError};
+use crate::hexapod::{Joint, JOINTS};
+use crate::robot::model::{FrictionModel, ModelOptions};
+use crate::robot::simulation::PlantOptions;
+
+// =============================================================================================
+// Raw mirror of the file
+// =============================================================================================
+
+/// The whole file.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawScenario {
+    scenario: RawHeader,
+    #[serde(default)]
+    model: RawModel,
+    #[serde(default)]
+    integrator: RawIntegrator,
+    #[serde(default)]
+    initial: RawInitial,
+    #[serde(default)]
+    control: RawControl,
+    gait: Option<RawGait>,
+}
+
+/// `[scenario]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawHeader {
+    name: String,
+    #[serde(default)]
+    description: String,
+    duration_s: f64,
+    #[serde(default = "default_robot")]
+    robot: String,
+}
+
+fn default_robot() -> String {
+    DEFAULT_ROBOT.to_string()
+}
+
+/// `[model]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    #[serde(default = "default_friction")]
+    friction: FrictionModel,
+    #[serde(default)]
+    load_dependence: bool,
+    #[serde(default)]
+    inductance: bool,
+    k_gnd: Option<f64>,
+    d_gnd: Option<f64>,
+    mu: Option<f64>,
+    supply_voltage_v: Option<f64>,
+    #[serde(default)]
+    joint_friction: RawJointFriction,
+}
+
+fn default_friction() -> FrictionModel {
+    FrictionModel::LuGre
+}
+
+impl Default for RawModel {
+    fn default() -> Self {
+        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None, joint_friction: Default::default() }
+    }
+}
+
+/// `[integrator]`.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawIntegrator {
+    tolerance: Option<f64>,
+    h_max_s: Option<f64>,
+}
+
+/// `[initial]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawInitial {
+    // The joint fields are options so that gait mode can reject them when written.
+    q_r_deg: Option<f64>,
+    q_v_m: Option<f64>,
+    q_h_m: Option<f64>,
+    lifted_legs: Option<Vec<i64>>,
+    q_v_lifted_m: Option<f64>,
+    #[serde(default = "default_true")]
+    settle: bool,
+    #[serde(default)]
+    body_height_offset_m: f64,
+}
+
+/// Defaults of `[initial]` (m): q_v of the supporting legs, q_h, q_v of the lifted legs.
+fn default_q_v() -> f64 {
+    0.06
+}
+fn default_q_h() -> f64 {
+    0.03
+}
+fn default_q_v_lifted() -> f64 {
+    0.045
+}
+fn default_true() -> bool {
+    true
+}
+
+impl Default for RawInitial {
+    fn default() -> Self {
+        RawInitial { q_r_deg: None, q_v_m: None, q_h_m: None, lifted_legs: None, q_v_lifted_m: None, settle: true, body_height_offset_m: 0.0 }
+    }
+}
+
+/// `[control]`.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawControl {
+    #[serde(default)]
+    mode: ControlMode,
+    #[serde(default)]
+    motion: Vec<RawMotion>,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+enum RawJoint {
+    #[serde(rename = "q_r")]
+    Rotation,
+    #[serde(rename = "q_v")]
+    Vertical,
+    #[serde(rename = "q_h")]
+    Horizontal,
+}
+
+#[derive(Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum MotionKind {
+    Ramp,
+    Sine,
+    Sawtooth,
+}
+
+/// One `[[control.motion]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMotion {
+    leg: i64,
+    joint: RawJoint,
+    kind: MotionKind,
+    rate: Option<f64>,
+    start_s: Option<f64>,
+    stop_s: Option<f64>,
+    amplitude: Option<f64>,
+    frequency_hz: Option<f64>,
+    min: Option<f64>,
+    max: Option<f64>,
+    speed: Option<f64>,
+}
+
+// =============================================================================================
+// Validation
+// =============================================================================================
+
+/// Relative tolerance on stroke checks (a sawtooth written to the printed stroke ends passes).
+const STROKE_TOLERANCE: f64 = 1e-6;
+
+pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir: &Path) -> Result<Scenario> {
+    let e = ScenarioError::from_parse;
+    let h = &raw.scenario;
+    if h.name.trim().is_empty() {
+        return Err(e(c.err("scenario.name", "\"\"", "empty", "a non-empty scenario name")));
+    }
+
+    // The robot first: the strokes and the control period bound the other fields.
+    let (mut robot, robot_source, robot_text) = if h.robot == DEFAULT_ROBOT {
+        (RobotDescription::amru5(), DEFAULT_ROBOT.to_string(), AMRU5_TOML.to_string())
+    } else {
+        let path: PathBuf = if Path::new(&h.robot).is_absolute() { PathBuf::from(&h.robot) } else { dir.join(&h.robot) };
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(&path).map_err(|err| {
+            e(c.err(
+                "scenario.robot",
+                format!("{:?}", h.robot),
+                &format!("cannot read {shown}: {err}"),
+                format!("\"{DEFAULT_ROBOT}\" (the embedded AMRU5 description) or the path of a robot description file, relative to the scenario file"),
+            ))
+        })?;
+        let robot = RobotDescription::from_str(&text, &shown).map_err(ScenarioError::Robot)?;
+        (robot, shown, text)
+    };
+    let period = robot.controller.period_s;
+    c.check(h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a duration >= {period} s (one control period)")).map_err(e)?;
+
+    // Model.
+    let m = &raw.model;
+    m.joint_friction.apply(c, &mut robot).map_err(e)?;
+    let mut model = ModelOptions::from_description(&robot, m.friction);
+    if m.load_dependence && m.friction == FrictionModel::None {
+        return Err(e(c.err("model.load_dependence", "true", "needs joint friction", "false with friction = \"none\" (or friction = \"dry_viscous\" or \"lugre\")")));
+    }
+    model.load_dependence = m.load_dependence;
+    model.inductance = m.inductance;
+    if let Some(v) = m.k_gnd {
+        c.positive("model.k_gnd", v).map_err(e)?;
+        model.ground.k_gnd = v;
+    }
+    if let Some(v) = m.d_gnd {
+        c.non_negative("model.d_gnd", v).map_err(e)?;
+        model.ground.d_gnd = v;
+    }
+    if let Some(v) = m.mu {
+        c.non_negative("model.mu", v).map_err(e)?;
+        model.ground.mu = v;
+    }
+    if let Some(v) = m.supply_voltage_v {
+        c.positive("model.supply_voltage_v", v).map_err(e)?;
+        model.supply_voltage = v;
+    }
+
+    // Integrator.
+    let mut plant = PlantOptions::from_description(&robot, &model);
+    if let Some(v) = raw.integrator.tolerance {
+        c.positive("integrator.tolerance", v).map_err(e)?;
+        plant.integrator.tolerance = v;
+    }
+    if let Some(v) = raw.integrator.h_max_s {
+        c.check(v > 0.0 && v <= period, "integrator.h_max_s", v, &format!("a step in (0, {period}] s (at most one control period)")).map_err(e)?;
+        plant.integrator.h_max = v;
+        plant.integrator.h_initial = plant.integrator.h_initial.min(v);
+    }
+
+    // Control mode and the walking set-up: in gait mode the initial joints come from the gait.
+    let mode = raw.control.mode;
+    let gait = match (mode, &raw.gait) {
+        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, dir, h.duration_s).map_err(e)?),
+        (ControlMode::Gait, None) => {
+            return Err(e(c.err("gait", "<missing>", "missing table", "a [gait] table with control.mode = \"gait\" (period_s, pattern, [gait.heading]; see the shipped walking scenarios)")));
+        }
+        (_, Some(_)) => {
+            return Err(e(c.err("gait", "[gait]", &format!("a [gait] table with control.mode = \"{}\"", mode.name()), "control.mode = \"gait\" with a [gait] table (or no [gait] table)")));
+        }
+        (_, None) => None,
+    };
+    if let Some(g) = &gait {
+        plant.navigation = g.navigation;
+    }
+
+    // Initial configuration.
+    let i = &raw.initial;
+    if gait.is_some() {
+        let written = [("q_r_deg", i.q_r_deg.map(|v| v.to_string())), ("q_v_m", i.q_v_m.map(|v| v.to_string())), ("q_h_m", i.q_h_m.map(|v| v.to_string())), ("lifted_legs", i.lifted_legs.as_ref().map(|v| format!("{v:?}"))), ("q_v_lifted_m", i.q_v_lifted_m.map(|v| v.to_string()))];
+        if let Some((name, Some(value))) = written.into_iter().find(|(_, v)| v.is_some()) {
+            return Err(e(c.err(
+                &format!("initial.{name}"),
+                value,
+                "not used in gait mode",
+                "only settle and body_height_offset_m in [initial] with control.mode = \"gait\": the feet start at their steady footholds at gait.body_height_m",
+            )));
+        }
+    }
+    let (q_r_deg, q_v_m, q_h_m, q_v_lifted_m) = (i.q_r_deg.unwrap_or(0.0), i.q_v_m.unwrap_or_else(default_q_v), i.q_h_m.unwrap_or_else(default_q_h), i.q_v_lifted_m.unwrap_or_else(default_q_v_lifted));
+    let range = |j: Joint| robot.joint_range(j);
+    let stroke = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str, what: &str| {
+        c.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}] {unit} ({what} of the robot description, joint_ranges)"))
+    };
+    let r = &robot.joint_ranges.q_r_deg;
+    stroke("initial.q_r_deg", q_r_deg, (r.min, r.max), "deg", "the q_r range").map_err(e)?;
+    stroke("initial.q_v_m", q_v_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
+    stroke("initial.q_h_m", q_h_m, range(Joint::Horizontal), "m", "the q_h stroke").map_err(e)?;
+    let mut lifted = Vec::new();
+    for (n, &leg) in i.lifted_legs.iter().flatten().enumerate() {
+        let field = format!("initial.lifted_legs[{n}]");
+        if !(0..6).contains(&leg) {
+            return Err(e(c.err(&field, leg, "no such leg", "a leg number 0..5")));
+        }
+        let leg = leg as usize;
+        if lifted.contains(&leg) {
+            return Err(e(c.err(&field, leg, "listed twice", "each leg at most once")));
+        }
+        lifted.push(leg);
+    }
+    lifted.sort_unstable();
+    if !lifted.is_empty() {
+        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
+        if q_v_lifted_m >= q_v_m {
+            return Err(e(c.err(
+                "initial.q_v_lifted_m",
+                q_v_lifted_m,
+                "does not lift the foot",
+                format!("a value < initial.q_v_m = {q_v_m} (a smaller q_v lifts the foot, z_foot ~ -6 q_v)"),
+            )));
+        }
+    }
+    if i.settle && lifted.len() > 3 {
+        return Err(e(c.err(
+            "initial.lifted_legs",
+            format!("{lifted:?}"),
+            "too few supporting legs to settle",
+            "at most 3 lifted legs with settle = true (a static equilibrium needs at least 3 feet on the ground)",
+        )));
+    }
+    c.check(i.body_height_offset_m >= 0.0, "initial.body_height_offset_m", i.body_height_offset_m, "a finite number >= 0 (m, added to the body height after settling)").map_err(e)?;
+    let joints: [f64; JOINTS] = match &gait {
+        Some(g) => g.joints,
+        None => std::array::from_fn(|k| match k % 3 {
+            0 => q_r_deg.to_radians(),
+            1 => {
+                if lifted.contains(&(k / 3)) {
+                    q_v_lifted_m
+                } else {
+                    q_v_m
+                }
+            }
+            _ => q_h_m,
+        }),
+    };
+    let initial = Initial { joints, lifted_legs: lifted, settle: i.settle, body_height_offset: i.body_height_offset_m };
+
+    // Joint motions.
+    if mode != ControlMode::Pi && !raw.control.motion.is_empty() {
+        return Err(e(c.err(
+            "control.motion",
+            format!("{} motion(s)", raw.control.motion.len()),
+            &format!("motions need mode = \"pi\" (not \"{}\")", mode.name()),
+            format!("no [[control.motion]] with mode = \"{}\" (or mode = \"pi\")", mode.name()),
+        )));
+    }
+    let mut motions = Vec::new();
+    let mut seen = BTreeSet::new();
+    for (n, rm) in raw.control.motion.iter().enumerate() {
+        let motion = validate_motion(rm, &format!("control.motion[{n}]"), c, &robot, &joints, h.duration_s).map_err(e)?;
+        if !seen.insert(motion.joint_index()) {
+            return Err(e(c.err(&format!("control.motion[{n}].joint"), motion.joint.symbol(), &format!("a second motion of leg {}'s {}", motion.leg, motion.joint), "one motion per (leg, joint)")));
+        }
+        motions.push(motion);
+    }
+
+    Ok(Scenario {
+        name: h.name.clone(),
+        description: h.description.clone(),
+        duration: h.duration_s,
+        robot,
+        robot_source,
+        robot_text,
+        model,
+        plant,
+        initial,
+        control: mode,
+        motions,
+        gait,
+        origin: origin.to_string(),
+        text: text.to_string(),
+    })
+}
+
+fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription, joints: &[f64; JOINTS], duration: f64) -> std::result::Result<Motion, DescriptionError> {
+    let field = |name: &str| format!("{path}.{name}");
+    if !(0..6).contains(&m.leg) {
+        return Err(c.err(&field("leg"), m.leg, "no such leg", "a leg number 0..5"));
+    }
+    let leg = m.leg as usize;
+    let joint = match m.joint {
+        RawJoint::Rotation => Joint::Rotation,
+        RawJoint::Vertical => Joint::Vertical,
+        RawJoint::Horizontal => Joint::Horizontal,
+    };
+    let base = joints[3 * leg + joint_number(joint)];
+    let (lo, hi) = robot.joint_range(joint);
+    let tol = STROKE_TOLERANCE * (hi - lo);
+    let unit = if joint.is_rotational() { "rad" } else { "m" };
+    let (kind, used): (&str, &[&str]) = match m.kind {
+        MotionKind::Ramp => ("ramp", &["rate", "start_s", "stop_s"]),
+        MotionKind::Sine => ("sine", &["amplitude", "frequency_hz"]),
+        MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed"]),
+    };
+    let fields = [("rate", m.rate), ("start_s", m.start_s), ("stop_s", m.stop_s), ("amplitude", m.amplitude), ("frequency_hz", m.frequency_hz), ("min", m.min), ("max", m.max), ("speed", m.speed)];
+    for (name, value) in fields {
+        if let Some(v) = value {
+            if !used.contains(&name) {
+                return Err(c.err(&field(name), v, &format!("not a field of kind = \"{kind}\""), format!("for kind = \"{kind}\": {}", used.join(", "))));
+            }
+        }
+    }
+    let required = |name: &str, v: Option<f64>| {
+        v.ok_or_else(|| c.err(&field(name), "<missing>", "missing field", format!("kind = \"{kind}\" needs {}", used.join(", "))))
+    };
+    let (lo_s, hi_s, base_s) = (short(lo), short(hi), short(base));
+    let stroke_text = format!("the {} stroke [{lo_s}, {hi_s}] {unit} (joint_ranges of the robot description; base {base_s} {unit})", joint.symbol());
+    let motion = match m.kind {
+        MotionKind::Ramp => {
+            let rate = required("rate", m.rate)?;
+            c.finite(&field("rate"), rate)?;
+            let start_s = m.start_s.unwrap_or(0.0);
+            c.non_negative(&field("start_s"), start_s)?;
+            let stop_s = m.stop_s.unwrap_or(duration.max(start_s));
+            c.check(stop_s >= start_s, &field("stop_s"), stop_s, &format!("a time >= start_s = {start_s} s"))?;
+            let span = stop_s.min(duration) - start_s;
+            if span > 0.0 {
+                let end = base + rate * span;
+                let ok = end >= lo - tol && end <= hi + tol;
+                let allowed = format!("a rate in [{:.6}, {:.6}] {unit}/s so that the reference stays in {stroke_text} over {span} s", (lo - base) / span, (hi - base) / span);
+                c.check(ok, &field("rate"), rate, &allowed)?;
+            }
+            JointMotion::Ramp { rate, start_s, stop_s }
+        }
+        MotionKind::Sine => {
+            let amplitude = required("amplitude", m.amplitude)?;
+            let frequency_hz = required("frequency_hz", m.frequency_hz)?;
+            let max = (hi - base).min(base - lo);
+            c.check(amplitude.abs() <= max + tol, &field("amplitude"), amplitude, &format!("|amplitude| <= {max:.6} {unit} so that the reference stays in {stroke_text}"))?;
+            c.positive(&field("frequency_hz"), frequency_hz)?;
+            JointMotion::Sine { amplitude, frequency_hz }
+        }
+        MotionKind::Sawtooth => {
+            let min = required("min", m.min)?;
+            let max = required("max", m.max)?;
+            let speed = required("speed", m.speed)?;
+            c.check(min >= lo - tol && min <= base, &field("min"), min, &format!("a value in [{lo_s}, {base_s}] {unit}: within {stroke_text}, at most the base"))?;
+            c.check(max <= hi + tol && max >= base && max > min, &field("max"), max, &format!("a value in [{base_s}, {hi_s}] {unit} and > min: within {stroke_text}, at least the base"))?;
+            c.positive(&field("speed"), speed)?;
+            JointMotion::Sawtooth { min, max, speed }
+        }
+    };
+    Ok(Motion { leg, joint, motion })
+}
+
+/// A number with at most 6 decimals, trailing zeros removed (0.4363323129985824 -> 0.436332).
+fn short(x: f64) -> String {
+    let s = format!("{x:.6}");
+    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
+    if s == "-0" { "0".to_string() } else { s.to_string() }
+}

@@ -1,0 +1,131 @@
+//! The run of a scenario: the model is built and settled, the controller of the control mode
+//! drives the [`SimulatedRobot`] over the duration, every control instant is recorded (the
+//! columns of [`crate::robot::columns`]) and observed for the [`Summary`].
+
+use std::cell::RefCell;
+use std::ops::ControlFlow;
+use std::rc::Rc;
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::summary::{summarize, GaitStats, RunStats};
+use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
+use crate::control::gait::schedule::GaitState;
+use crate::control::{joint_pis, Controller, JointPiController, JointReferences, Unpowered};
+use crate::physics::FlatGround;
+use crate::robot::columns::{record_row, ColumnGroups};
+use crate::robot::model::{FrictionModel, Robot, RobotModel};
+use crate::robot::recorder::{Recorder, TimeSeries};
+use crate::robot::simulation::{run_until, SimulatedRobot};
+use crate::sim::{static_equilibrium, SimError, StaticOptions};
+
+/// The outcome of [`run_scenario`].
+#[derive(Clone, Debug)]
+pub struct ScenarioResults {
+    /// One row per control instant; empty with [`Record::SummaryOnly`].
+    pub series: TimeSeries,
+    pub summary: Summary,
+}
+
+/// What a run keeps besides its summary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Record {
+    /// The time series of every control instant (the columns of [`crate::robot::columns`]).
+    TimeSeries,
+    /// The summary alone (campaigns of many runs): no time series is built.
+    SummaryOnly,
+}
+
+/// Runs a scenario and records its time series; `progress` is called with the simulated time
+/// at every control instant.
+pub fn run_scenario(s: &Scenario, mut progress: impl FnMut(f64)) -> Result<ScenarioResults> {
+    run_scenario_until(s, Record::TimeSeries, |t| {
+        progress(t);
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`run_scenario`] keeping what `record` says, with a `progress` that may stop the run
+/// ([`ScenarioError::Stopped`]).
+pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
+    let started = Instant::now();
+    let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
+    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
+    let (q, qd) = initial_state(s, &model)?;
+    let mut plant = SimulatedRobot::new(model.clone(), &q, &qd, &s.plant).map_err(sim_err("the start"))?;
+    let (mut controller, gait_state) = controller(s);
+
+    // The joint references are recorded and tracked by the PI loops in these modes.
+    let pi = matches!(s.control, ControlMode::Pi | ControlMode::Gait);
+    let groups = ColumnGroups { references: pi, bristles: s.model.friction == FrictionModel::LuGre };
+    let supply = s.model.supply_voltage;
+    let mut rec = Recorder::default();
+    let mut stats = RunStats::default();
+    let mut gait_stats = GaitStats::default();
+    let mut last_t = 0.0;
+    let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
+        let state = gait_state.as_ref().map(|g| g.borrow());
+        if record == Record::TimeSeries {
+            record_row(&mut rec, p, meas, cmd, groups, state.as_deref());
+        }
+        stats.observe(p, cmd, supply, pi);
+        if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
+            let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
+            gait_stats.observe(p.state().q.as_slice(), state, feet_down, &g.workspaces);
+        }
+        last_t = meas.t;
+        progress(meas.t)
+    })
+    .map_err(sim_err("the simulation"))?;
+    if flow.is_break() {
+        return Err(ScenarioError::Stopped { file: s.origin.clone(), t: last_t });
+    }
+
+    let series = rec.finish();
+    let mut summary = summarize(s, &plant, &stats, &q, started.elapsed().as_secs_f64());
+    if let (Some(g), Some(state)) = (&s.gait, &gait_state) {
+        summary.gait = Some(GaitSummary::new(g, &gait_stats, &state.borrow().diagnostics));
+    }
+    Ok(ScenarioResults { series, summary })
+}
+
+/// The start (q, q'): feet on the ground, static equilibrium with the joints locked (Section
+/// 6.2) unless `initial.settle` is off, then the body raised by `initial.body_height_offset`.
+fn initial_state(s: &Scenario, model: &Arc<RobotModel>) -> Result<(Vec<f64>, Vec<f64>)> {
+    let mut q = model.touching_ground(&s.initial.joints);
+    let mut qd = vec![0.0; q.len()];
+    if s.initial.settle {
+        let mut robot = Robot::new(model.clone());
+        let options = StaticOptions { residual_tolerance: 1e-6, max_iterations: 200 };
+        static_equilibrium(&mut robot, 0.0, &mut q, &mut qd, &model.standing_locks(), &options).map_err(|source| ScenarioError::Simulation {
+            file: s.origin.clone(),
+            stage: "settling (static equilibrium with the joints locked)",
+            source,
+            hint: "; check that the supporting feet surround the centre of mass (initial.lifted_legs)",
+        })?;
+        let (pitch, roll) = (q[4].to_degrees(), q[5].to_degrees());
+        if pitch.abs() > 5.0 || roll.abs() > 5.0 {
+            return Err(ScenarioError::Tipped { file: s.origin.clone(), pitch_deg: pitch, roll_deg: roll });
+        }
+    }
+    q[2] += s.initial.body_height_offset;
+    Ok((q, qd))
+}
+
+/// The controller of the scenario's control mode and, walking, the state the gait controller
+/// publishes after each update.
+fn controller(s: &Scenario) -> (Box<dyn Controller>, Option<Rc<RefCell<GaitState>>>) {
+    match s.control {
+        ControlMode::Gait => {
+            let g = s.gait.as_ref().expect("gait mode has a validated [gait]");
+            let (controller, state) = g.controller(&s.robot);
+            (Box::new(controller), Some(state))
+        }
+        ControlMode::Pi => {
+            let pis = joint_pis(&s.robot, s.plant.period);
+            let motions = s.motions.iter().map(|m| (m.joint_index(), m.motion)).collect();
+            (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), None)
+        }
+        ControlMode::Unpowered => (Box::new(Unpowered), None),
+    }
+}
