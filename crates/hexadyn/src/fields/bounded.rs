@@ -1,7 +1,7 @@
 //! Bounded fields: the constraint of a single field is declared with the field in the file
 //! mirror and checked while deserializing.
 //!
-//! ```ignore
+//! ```text
 //! #[derive(Deserialize)]
 //! struct MotorTable {
 //!     #[serde(deserialize_with = "Positive::checked")]
