@@ -5,6 +5,7 @@ use pyo3::prelude::*;
 mod mbs;
 mod monte_carlo;
 mod scenario;
+mod view;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -14,5 +15,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
+    m.add_class::<view::PyKinematics>()?;
     Ok(())
 }
