@@ -1,0 +1,67 @@
+"""A local viewer server (loopback only) on a free port: :func:`start` for scripts and tests,
+:func:`serve` for ``hexadyn view`` (prints the URL, opens the browser, runs until Ctrl-C)."""
+
+from __future__ import annotations
+
+import logging
+import socket
+import webbrowser
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from hexadyn.view.data import Run
+
+HOST = "127.0.0.1"
+
+
+def free_port(host: str = HOST) -> int:
+    """A TCP port nobody listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+@dataclass
+class RunningViewer:
+    """A started viewer: its URL, the :class:`~hexadyn.view.app.Viewer` and :meth:`stop`."""
+
+    url: str
+    viewer: "object"
+    server: "object"
+
+    def stop(self) -> None:
+        self.viewer.close()
+        self.server.stop()
+
+
+def start(folder: str | Path, port: int | None = None) -> RunningViewer:
+    """Starts a viewer of the results `folder` on 127.0.0.1 (a free port unless `port`)."""
+    import viser
+
+    from hexadyn.view.app import Viewer
+
+    run = Run(folder)
+    port = port or free_port()
+    logging.getLogger("websockets").setLevel(logging.WARNING)
+    server = viser.ViserServer(host=HOST, port=port, verbose=False)
+    try:
+        viewer = Viewer(server, run)
+    except BaseException:
+        server.stop()
+        raise
+    return RunningViewer(url=f"http://{HOST}:{port}/", viewer=viewer, server=server)
+
+
+def serve(folder: str | Path, port: int | None = None, open_browser: bool = True, echo: Callable[[str], None] = print) -> None:
+    """Shows `folder` until interrupted: prints the URL and opens it unless `open_browser` is false."""
+    running = start(folder, port)
+    echo(f"Viewing {folder} at {running.url} (Ctrl-C to stop)")
+    if open_browser:
+        webbrowser.open(running.url)
+    try:
+        running.server.sleep_forever()  # type: ignore[attr-defined]
+    except KeyboardInterrupt:
+        pass
+    finally:
+        running.stop()
