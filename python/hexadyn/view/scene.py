@@ -72,6 +72,10 @@ class RobotScene:
         self.run = run
         scene = server.scene
         scene.set_up_direction("+z")
+        # Shadows and image-based lighting cost tens of milliseconds a frame in software WebGL.
+        scene.configure_default_lights(cast_shadow=False)
+        scene.configure_environment_map(hdri=None)
+        scene.add_light_hemisphere("/light", sky_color=(255, 255, 255), ground_color=(140, 130, 120), intensity=2.5)
         g = run.geometry
         names = run.body_names
         self._chassis = [names.index(f"leg{leg}.chassis") for leg in range(LEGS)]
