@@ -26,8 +26,10 @@ from hexadyn.view.scene import RobotScene
 
 #: Playback speeds offered (simulated seconds per wall-clock second).
 SPEEDS = ("0.25", "0.5", "1", "2", "5", "10", "50")
-#: Playback ticks per second, and chart cursor updates per second while playing.
-TICK_HZ = 60.0
+#: While playing: scene updates per second, and updates per second of the panel (time slider and
+#: read-out) and of the chart cursors, fewer as they cost the browser more than the scene.
+TICK_HZ = 30.0
+PANEL_HZ = 10.0
 CURSOR_HZ = 4.0
 #: Camera offset from the body when following it, and the initial view (m).
 CAMERA_OFFSET = np.array([-0.9, -1.4, 0.8])
@@ -43,6 +45,7 @@ class Viewer:
         self._playing = False
         self._stop = threading.Event()
         self._last_cursor = 0.0
+        self._last_panel = 0.0
         body = run.q[0, :3]
         server.initial_camera.position = tuple(body + CAMERA_OFFSET)
         server.initial_camera.look_at = tuple(body)
@@ -120,6 +123,7 @@ class Viewer:
         with self._lock:
             self._playing = False
             self.play_button.label, self.play_button.icon = "Play", viser.Icon.PLAYER_PLAY
+            self._show_panel()
             self._move_cursors()
 
     @property
@@ -133,14 +137,19 @@ class Viewer:
 
     # -- internals -----------------------------------------------------------------------------
 
-    def _show(self, frame: Frame) -> None:
+    def _show(self, frame: Frame, panel: bool = True) -> None:
         self.frame = frame
         with self.server.atomic():
             self.scene.show(frame)
-        self.time_slider.value = frame.t
-        self.readout.content = _readout(frame)
         if self.follow.value:
             self._follow(frame.body_position)
+        if panel:
+            self._show_panel()
+
+    def _show_panel(self) -> None:
+        self.time_slider.value = self.frame.t
+        self.readout.content = _readout(self.frame)
+        self._last_panel = time.monotonic()
 
     def _follow(self, body: np.ndarray) -> None:
         for client in self.server.get_clients().values():
@@ -172,7 +181,7 @@ class Viewer:
                 last = now
                 index = self.run.index_at(sim_time)
                 if index != self.frame.index:
-                    self._show(self.run.frame(index))
+                    self._show(self.run.frame(index), panel=now - self._last_panel >= 1.0 / PANEL_HZ)
                 if now - self._last_cursor >= 1.0 / CURSOR_HZ:
                     self._move_cursors()
                 if index >= self.run.t.size - 1:

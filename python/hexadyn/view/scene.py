@@ -32,7 +32,7 @@ FORCE_SCALE_M_PER_N = 1.5e-3
 LINK_WIDTH = 0.014
 FOOT_RADIUS = 0.012
 #: Most points drawn for a path (decimated beyond).
-PATH_POINTS = 2000
+PATH_POINTS = 500
 
 
 def _wxyz(rotations: np.ndarray) -> np.ndarray:
@@ -123,12 +123,12 @@ class RobotScene:
         # Terrain: the flat ground z = 0 of the contact model.
         scene.add_grid("/terrain", width=float(size[0]), height=float(size[1]), plane="xy", cell_size=0.1, section_size=1.0, plane_color=(235, 232, 225), plane_opacity=1.0, position=(float(centre[0]), float(centre[1]), 0.0))
         if len(ground) > 1:
-            scene.add_line_segments("/paths/body", np.stack([ground[:-1], ground[1:]], axis=1), colors=PATH_COLOUR, thickness=0.006)
+            scene.add_line_segments("/paths/body", np.stack([ground[:-1], ground[1:]], axis=1), colors=PATH_COLOUR, thickness=3.0, thickness_units="screen")
         if run.reference_xy is not None:
             ref = run.reference_xy[keep]
             ref3 = np.column_stack([ref, np.full(len(ref), 0.003)])
             if len(ref3) > 1:
-                scene.add_line_segments("/paths/reference", np.stack([ref3[:-1], ref3[1:]], axis=1), colors=REFERENCE_COLOUR, thickness=0.006)
+                scene.add_line_segments("/paths/reference", np.stack([ref3[:-1], ref3[1:]], axis=1), colors=REFERENCE_COLOUR, thickness=3.0, thickness_units="screen")
         if len(holds):
             marks = holds.copy()
             marks[:, 2] = np.maximum(marks[:, 2], 0.0) + 0.001
