@@ -11,7 +11,7 @@ Measures, on the validation walk (or FOLDER):
 Software WebGL (SwiftShader: no GPU here) on a shared 2-core machine is the worst case; a
 desktop browser with a GPU renders at its display rate.
 
-    .venv/bin/python benches/view.py [FOLDER] [--seconds 5] [--long] [--chromium-arg=--disable-gpu-compositing]
+    .venv/bin/python benches/view.py [FOLDER] [--seconds 5] [--speed 1] [--long] [--chromium-arg=...]
 """
 
 from __future__ import annotations
@@ -25,28 +25,14 @@ from pathlib import Path
 import hexadyn
 from hexadyn.view.data import Run
 from hexadyn.view.export import export_html
+from hexadyn.view.measure import FRAME_COUNTER_JS, HEADLESS_CHROMIUM_ARGS
 from hexadyn.view.server import start
 
-#: Counts the animation frames in which the page drew with WebGL (window.__frames).
-FRAME_COUNTER = """
-(() => {
-  window.__frames = 0; let drawn = false;
-  const raf = window.requestAnimationFrame.bind(window);
-  window.requestAnimationFrame = (cb) => raf((ts) => { drawn = false; cb(ts); if (drawn) window.__frames++; });
-  for (const C of [WebGLRenderingContext, WebGL2RenderingContext]) {
-    for (const name of ["drawElements", "drawArrays", "drawElementsInstanced", "drawArraysInstanced"]) {
-      const f = C.prototype[name];
-      if (f) C.prototype[name] = function (...a) { drawn = true; return f.apply(this, a); };
-    }
-  }
-})();
-"""
-CHROMIUM_ARGS = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 
 
 def frames_per_second(browser, url: str, seconds: float, start_playing=None) -> float:
     page = browser.new_page(viewport={"width": 1280, "height": 800})
-    page.add_init_script(FRAME_COUNTER)
+    page.add_init_script(FRAME_COUNTER_JS)
     page.goto(url)
     page.wait_for_selector("canvas", timeout=60000)
     time.sleep(3.0)
@@ -80,7 +66,7 @@ def main() -> None:
         running = start(folder)
         try:
             with sync_playwright() as p:
-                browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=CHROMIUM_ARGS + args.chromium_arg)
+                browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=HEADLESS_CHROMIUM_ARGS + args.chromium_arg)
 
                 def play() -> None:
                     running.viewer.speed.value = args.speed
@@ -92,7 +78,7 @@ def main() -> None:
         finally:
             running.stop()
         print(f"{folder}: live page playing at {args.speed}x: {live:.1f} frames/s; HTML export ({export.stat().st_size / 1e6:.1f} MB) playing: {exported:.1f} frames/s")
-        print(f"  (headless Chromium, software WebGL, 1280 x 800, flags {' '.join(CHROMIUM_ARGS + args.chromium_arg)})")
+        print(f"  (headless Chromium, software WebGL, 1280 x 800, flags {' '.join(HEADLESS_CHROMIUM_ARGS + args.chromium_arg)})")
         if args.long:
             long_run(work)
     finally:

@@ -114,7 +114,7 @@ class RobotScene:
         path = run.body_path()
         keep = decimation(len(path), PATH_POINTS)
         ground = path[keep].copy()
-        ground[:, 2] = 0.002
+        ground[:, 2] = 0.004
         holds = run.footholds()
         extent = np.vstack([path[:, :2], holds[:, :2]]) if len(holds) else path[:, :2]
         lo, hi = extent.min(axis=0) - 1.0, extent.max(axis=0) + 1.0
@@ -123,12 +123,12 @@ class RobotScene:
         # Terrain: the flat ground z = 0 of the contact model.
         scene.add_grid("/terrain", width=float(size[0]), height=float(size[1]), plane="xy", cell_size=0.1, section_size=1.0, plane_color=(235, 232, 225), plane_opacity=1.0, position=(float(centre[0]), float(centre[1]), 0.0))
         if len(ground) > 1:
-            scene.add_line_segments("/paths/body", np.stack([ground[:-1], ground[1:]], axis=1), colors=PATH_COLOUR, thickness=3.0, thickness_units="screen")
+            scene.add_line_segments("/paths/body", np.stack([ground[:-1], ground[1:]], axis=1), colors=PATH_COLOUR, thickness=2.0, thickness_units="screen")
         if run.reference_xy is not None:
             ref = run.reference_xy[keep]
-            ref3 = np.column_stack([ref, np.full(len(ref), 0.003)])
+            ref3 = np.column_stack([ref, np.full(len(ref), 0.002)])
             if len(ref3) > 1:
-                scene.add_line_segments("/paths/reference", np.stack([ref3[:-1], ref3[1:]], axis=1), colors=REFERENCE_COLOUR, thickness=3.0, thickness_units="screen")
+                scene.add_line_segments("/paths/reference", np.stack([ref3[:-1], ref3[1:]], axis=1), colors=REFERENCE_COLOUR, thickness=6.0, thickness_units="screen")
         if len(holds):
             marks = holds.copy()
             marks[:, 2] = np.maximum(marks[:, 2], 0.0) + 0.001
