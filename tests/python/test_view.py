@@ -189,6 +189,20 @@ def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder,
     wait_for(lambda: state(page)["t"] == paused, what="the page to show the paused frame")
     time.sleep(0.5)
     assert state(page)["t"] == paused
+
+    # Follow the body: the camera keeps its offset and looks at the body as time moves.
+    page.get_by_label("Follow body").check()
+    wait_for(lambda: live.viewer.follow.value, what="the follow box to reach the viewer")
+    box.fill("5")
+    box.press("Enter")
+    wait_for(lambda: abs(state(page)["t"] - 5.0) < 1e-9, what="the page to show t = 5")
+    client = next(iter(live.server.get_clients().values()))
+    wait_for(lambda: np.allclose(client.camera.look_at, live.viewer.frame.body_position, atol=1e-4), what="the camera to look at the body")
+
+    # Another signal group and leg: the charts are rebuilt with their series.
+    live.viewer.group.value = "Currents"
+    live.viewer.leg.value = "3"
+    page.get_by_text("Currents: i_q_h[3] (A)").wait_for(timeout=20000)
     page.close()
 
 

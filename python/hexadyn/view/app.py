@@ -31,8 +31,6 @@ SPEEDS = ("0.25", "0.5", "1", "2", "5", "10", "50")
 TICK_HZ = 30.0
 PANEL_HZ = 10.0
 CURSOR_HZ = 4.0
-#: Camera offset from the body when following it, and the initial view (m).
-CAMERA_OFFSET = np.array([-0.9, -1.4, 0.8])
 
 
 class Viewer:
@@ -46,10 +44,6 @@ class Viewer:
         self._stop = threading.Event()
         self._last_cursor = 0.0
         self._last_panel = 0.0
-        body = run.q[0, :3]
-        server.initial_camera.position = tuple(body + CAMERA_OFFSET)
-        server.initial_camera.look_at = tuple(body)
-        server.initial_camera.up = (0.0, 0.0, 1.0)
         self.scene = RobotScene(server, run)
         self._build_panel()
         self.frame: Frame = run.frame(0)
@@ -152,11 +146,11 @@ class Viewer:
         self._last_panel = time.monotonic()
 
     def _follow(self, body: np.ndarray) -> None:
+        """Translates each client's camera so that it looks at the body from where it was
+        (viser moves the look-at point with the position)."""
         for client in self.server.get_clients().values():
             offset = np.asarray(client.camera.position) - np.asarray(client.camera.look_at)
-            with client.atomic():
-                client.camera.look_at = body
-                client.camera.position = body + offset
+            client.camera.position = body + offset
 
     def _move_cursors(self) -> None:
         self.charts.move_cursor(self.frame.t)

@@ -7,6 +7,8 @@ its top at the sample nearest the current time.
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 import viser
 import viser.uplot
@@ -21,24 +23,28 @@ SERIES_COLOURS = ("#1f5fbf", "#2a9d3a", "#c0392b", "#8e44ad", "#e67e22", "#16a08
 GAIT_LEVEL = {0: 0.7, 1: 0.35, 2: 0.0, 3: 0.35}
 
 
-def signal_groups(run: Run) -> dict[str, dict[str, object]]:
-    """The plottable signal groups of `run`: name -> {"series": fn(leg, joint) -> list of (label,
-    terms)}, terms as in :func:`_evaluate`. Groups whose columns are not recorded are left out."""
+#: The series of one chart: (label, terms) pairs for a leg and a joint; terms as in _evaluate.
+SeriesOf = Callable[[int, str], list[tuple[str, tuple[str, ...]]]]
+
+
+def signal_groups(run: Run) -> dict[str, SeriesOf]:
+    """The plottable signal groups of `run`: name -> the series of a leg's joint chart. Groups
+    whose columns are not recorded are left out."""
     have = set(run.columns)
-    groups: dict[str, dict[str, object]] = {}
 
     def every(pattern: str) -> bool:
         return all(pattern.format(j=j, l=leg) in have for j in JOINTS for leg in range(LEGS))
 
+    groups: dict[str, SeriesOf] = {}
     if every("{j}_ref[{l}]"):
-        groups["Joint positions"] = {"series": lambda leg, j: [(f"{j}[{leg}]", (f"{j}[{leg}]",)), (f"{j}_ref[{leg}]", (f"{j}_ref[{leg}]",))]}
-        groups["Tracking errors"] = {"series": lambda leg, j: [(f"{j}_ref[{leg}] - {j}[{leg}]", (f"{j}_ref[{leg}]", f"-{j}[{leg}]"))]}
+        groups["Joint positions"] = lambda leg, j: [(f"{j}[{leg}]", (f"{j}[{leg}]",)), (f"{j}_ref[{leg}]", (f"{j}_ref[{leg}]",))]
+        groups["Tracking errors"] = lambda leg, j: [(f"{j}_ref[{leg}] - {j}[{leg}]", (f"{j}_ref[{leg}]", f"-{j}[{leg}]"))]
     else:
-        groups["Joint positions"] = {"series": lambda leg, j: [(f"{j}[{leg}]", (f"{j}[{leg}]",))]}
+        groups["Joint positions"] = lambda leg, j: [(f"{j}[{leg}]", (f"{j}[{leg}]",))]
     if every("i_{j}[{l}]"):
-        groups["Currents"] = {"series": lambda leg, j: [(f"i_{j}[{leg}] (A)", (f"i_{j}[{leg}]",))]}
-    if every("i_{j}[{l}]") and every("u_{j}[{l}]"):
-        groups["Power"] = {"series": lambda leg, j: [(f"u i {j}[{leg}] (W)", (f"u_{j}[{leg}]*i_{j}[{leg}]",))]}
+        groups["Currents"] = lambda leg, j: [(f"i_{j}[{leg}] (A)", (f"i_{j}[{leg}]",))]
+        if every("u_{j}[{l}]"):
+            groups["Power"] = lambda leg, j: [(f"u i {j}[{leg}] (W)", (f"u_{j}[{leg}]*i_{j}[{leg}]",))]
     return groups
 
 
@@ -97,12 +103,12 @@ class SignalCharts:
     """The three joint charts (q_r, q_v, q_h) of one leg for one signal group."""
 
     def __init__(self, gui: viser.GuiApi, run: Run, group: str, leg: int):
-        spec = signal_groups(run)[group]
+        series_of = signal_groups(run)[group]
         rows = decimation(run.t.size, PLOT_POINTS)
         t = run.t[rows]
         self.charts = []
         for j in JOINTS:
-            series = [(label, _evaluate(run, terms, rows)) for label, terms in spec["series"](leg, j)]  # type: ignore[operator]
+            series = [(label, _evaluate(run, terms, rows)) for label, terms in series_of(leg, j)]
             self.charts.append(Chart(gui, f"{group}: {series[0][0]}", t, series, height=150))
 
     def move_cursor(self, t: float) -> None:

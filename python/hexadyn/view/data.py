@@ -44,7 +44,6 @@ class Frame:
 
     index: int
     t: float
-    q: np.ndarray
     #: Body position (3,) and rotation matrix (3, 3), body to world.
     body_position: np.ndarray
     body_rotation: np.ndarray
@@ -96,7 +95,6 @@ class Run:
         if missing:
             raise ViewError(f"{table_path}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
         self.name: str = self.metadata.get("scenario_name") or self.folder.name
-        self.units: dict[str, str] = self.metadata.get("units", {})
         wanted = ["t", *Q_COLUMNS, *FOOT_COLUMNS, *FORCE_COLUMNS]
         self.has_phases = all(c in self.columns for c in PHASE_COLUMNS)
         self.has_reference = all(c in self.columns for c in REFERENCE_COLUMNS)
@@ -148,7 +146,6 @@ class Run:
         return Frame(
             index=index,
             t=float(self.t[index]),
-            q=q[0],
             body_position=positions[0, 0],
             body_rotation=rotations[0, 0],
             positions=positions[0],

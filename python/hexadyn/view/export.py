@@ -33,7 +33,6 @@ def export_html(folder: str | Path, file: str | Path, fps: float = EXPORT_FPS, m
     """Writes the animation of the results `folder` to the HTML `file`; returns its path."""
     import viser
 
-    from hexadyn.view.app import CAMERA_OFFSET
     from hexadyn.view.scene import RobotScene
     from hexadyn.view.server import HOST, free_port
 
@@ -45,10 +44,6 @@ def export_html(folder: str | Path, file: str | Path, fps: float = EXPORT_FPS, m
     logging.getLogger("websockets").setLevel(logging.WARNING)
     server = viser.ViserServer(host=HOST, port=free_port(), verbose=False)
     try:
-        body = run.q[0, :3]
-        server.initial_camera.position = tuple(body + CAMERA_OFFSET)
-        server.initial_camera.look_at = tuple(body)
-        server.initial_camera.up = (0.0, 0.0, 1.0)
         scene = RobotScene(server, run)
         recorder = server.get_scene_serializer()
         for previous, index in zip(indices[:-1], indices[1:]):

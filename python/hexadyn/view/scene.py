@@ -31,6 +31,8 @@ FORCE_SCALE_M_PER_N = 1.5e-3
 #: Link cross-section (m) and foot sphere radius (m).
 LINK_WIDTH = 0.014
 FOOT_RADIUS = 0.012
+#: Initial camera: offset from the body's start (m), looking at it.
+CAMERA_OFFSET = np.array([-0.9, -1.4, 0.8])
 #: Most points drawn for a path (decimated beyond).
 PATH_POINTS = 500
 
@@ -66,12 +68,17 @@ def _prism(polygon: np.ndarray, z0: float, z1: float) -> tuple[np.ndarray, np.nd
 
 
 class RobotScene:
-    """The scene of one run; :meth:`show` moves the robot to a frame."""
+    """The scene of one run, with the initial camera on the robot; :meth:`show` moves the robot
+    to a frame."""
 
     def __init__(self, server: viser.ViserServer, run: Run):
         self.run = run
         scene = server.scene
         scene.set_up_direction("+z")
+        start = run.q[0, :3]
+        server.initial_camera.position = tuple(start + CAMERA_OFFSET)
+        server.initial_camera.look_at = tuple(start)
+        server.initial_camera.up = (0.0, 0.0, 1.0)
         # Shadows and image-based lighting cost tens of milliseconds a frame in software WebGL.
         scene.configure_default_lights(cast_shadow=False)
         scene.configure_environment_map(hdri=None)

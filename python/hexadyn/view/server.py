@@ -8,9 +8,14 @@ import socket
 import webbrowser
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from hexadyn.view.data import Run
+
+if TYPE_CHECKING:  # viser is imported when a viewer starts
+    import viser
+
+    from hexadyn.view.app import Viewer
 
 HOST = "127.0.0.1"
 
@@ -27,8 +32,8 @@ class RunningViewer:
     """A started viewer: its URL, the :class:`~hexadyn.view.app.Viewer` and :meth:`stop`."""
 
     url: str
-    viewer: "object"
-    server: "object"
+    viewer: "Viewer"
+    server: "viser.ViserServer"
 
     def stop(self) -> None:
         self.viewer.close()
@@ -60,7 +65,7 @@ def serve(folder: str | Path, port: int | None = None, open_browser: bool = True
     if open_browser:
         webbrowser.open(running.url)
     try:
-        running.server.sleep_forever()  # type: ignore[attr-defined]
+        running.server.sleep_forever()
     except KeyboardInterrupt:
         pass
     finally:
