@@ -110,6 +110,37 @@ def test_view_kinematics_reproduce_the_recorded_feet(walk_folder):
         kin.poses(np.zeros((2, 23)))
 
 
+def test_view_draws_the_robot_of_the_description(walk_folder):
+    """The geometry comes from the robot description: another R_rot moves the hips."""
+    run = Run(walk_folder)
+    text = run.metadata["robot"]
+    assert "r_rot_m = 0.175" in text
+    for r_rot in (0.175, 0.21):
+        kin = _core.Kinematics(text.replace("r_rot_m = 0.175", f"r_rot_m = {r_rot}"))
+        assert kin.geometry["r_rot"] == r_rot
+        hips = kin.leg_points(run.q[:1])[0, :, 0]
+        assert np.allclose(np.linalg.norm(hips[:, :2] - run.q[0, :2], axis=1), r_rot, atol=1e-3)
+
+
+def test_view_command_serves_on_loopback_and_prints_the_url(walk_folder):
+    """`hexadyn view FOLDER --no-open` serves the page on 127.0.0.1 and prints its URL."""
+    import re
+    import subprocess
+    import sys
+    import urllib.request
+
+    process = subprocess.Popen([sys.executable, "-m", "hexadyn.cli", "view", str(walk_folder), "--no-open"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        line = process.stdout.readline()
+        url = re.search(r"http://127\.0\.0\.1:\d+/", line)
+        assert url, line
+        with urllib.request.urlopen(url.group(0), timeout=20) as response:
+            assert response.status == 200 and b"<html" in response.read(2000).lower()
+    finally:
+        process.terminate()
+        process.wait(timeout=20)
+
+
 def test_view_rejects_what_is_not_a_results_folder(walk_folder, tmp_path):
     with pytest.raises(ViewError, match="no such results folder"):
         Run(tmp_path / "missing")

@@ -53,7 +53,7 @@ class Viewer:
 
     def _build_panel(self) -> None:
         gui, run = self.server.gui, self.run
-        gui.configure_theme(control_width="large", dark_mode=False, show_logo=False)
+        gui.configure_theme(control_width="large", dark_mode=False, show_logo=False, show_share_button=False)  # loopback only
         gui.add_markdown(f"**{html.escape(run.name)}**  \n{run.duration:g} s, {run.t.size} frames")
         with gui.add_folder("Playback"):
             step = float(np.median(np.diff(run.t))) if run.t.size > 1 else 1.0

@@ -9,7 +9,6 @@ spread in time, so the file stays small (a few MB for a 60 s walk at 25 frames p
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 import numpy as np
@@ -31,18 +30,15 @@ def frame_indices(run: Run, fps: float = EXPORT_FPS, max_frames: int = MAX_FRAME
 
 def export_html(folder: str | Path, file: str | Path, fps: float = EXPORT_FPS, max_frames: int = MAX_FRAMES) -> Path:
     """Writes the animation of the results `folder` to the HTML `file`; returns its path."""
-    import viser
-
     from hexadyn.view.scene import RobotScene
-    from hexadyn.view.server import HOST, free_port
+    from hexadyn.view.server import stop_quietly, viser_server
 
     run = Run(folder)
     file = Path(file)
     if file.is_dir():
         raise ValueError(f"{file}: is a folder; give the HTML file to write")
     indices = frame_indices(run, fps, max_frames)
-    logging.getLogger("websockets").setLevel(logging.WARNING)
-    server = viser.ViserServer(host=HOST, port=free_port(), verbose=False)
+    server = viser_server()
     try:
         scene = RobotScene(server, run)
         recorder = server.get_scene_serializer()
@@ -51,7 +47,7 @@ def export_html(folder: str | Path, file: str | Path, fps: float = EXPORT_FPS, m
             scene.show(run.frame(int(index)))
         page = recorder.as_html()
     finally:
-        server.stop()
+        stop_quietly(server)
     file.parent.mkdir(parents=True, exist_ok=True)
     tmp = file.with_name(f".{file.name}.tmp")
     tmp.write_text(page, encoding="utf-8")

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import logging
 import socket
 import webbrowser
@@ -27,6 +29,21 @@ def free_port(host: str = HOST) -> int:
         return int(s.getsockname()[1])
 
 
+def viser_server(port: int | None = None) -> "viser.ViserServer":
+    """A viser server on 127.0.0.1 (a free port unless `port`), without viser's banner on stdout."""
+    import viser
+
+    logging.getLogger("websockets").setLevel(logging.WARNING)
+    with contextlib.redirect_stdout(io.StringIO()):
+        return viser.ViserServer(host=HOST, port=port or free_port(), verbose=False)
+
+
+def stop_quietly(server: "viser.ViserServer") -> None:
+    """Stops a viser server without its message on stdout."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
+
+
 @dataclass
 class RunningViewer:
     """A started viewer: its URL, the :class:`~hexadyn.view.app.Viewer` and :meth:`stop`."""
@@ -37,25 +54,21 @@ class RunningViewer:
 
     def stop(self) -> None:
         self.viewer.close()
-        self.server.stop()
+        stop_quietly(self.server)
 
 
 def start(folder: str | Path, port: int | None = None) -> RunningViewer:
     """Starts a viewer of the results `folder` on 127.0.0.1 (a free port unless `port`)."""
-    import viser
-
     from hexadyn.view.app import Viewer
 
     run = Run(folder)
-    port = port or free_port()
-    logging.getLogger("websockets").setLevel(logging.WARNING)
-    server = viser.ViserServer(host=HOST, port=port, verbose=False)
+    server = viser_server(port)
     try:
         viewer = Viewer(server, run)
     except BaseException:
-        server.stop()
+        stop_quietly(server)
         raise
-    return RunningViewer(url=f"http://{HOST}:{port}/", viewer=viewer, server=server)
+    return RunningViewer(url=f"http://{HOST}:{server.get_port()}/", viewer=viewer, server=server)
 
 
 def serve(folder: str | Path, port: int | None = None, open_browser: bool = True, echo: Callable[[str], None] = print) -> None:
