@@ -65,11 +65,20 @@ def canvas_png(page, path: Path) -> np.ndarray:
     return imread(path)[..., :3]
 
 
-def link_share(image: np.ndarray) -> float:
-    """The share of pixels in the warm tan/orange of the pantograph links (LINK_COLOURS of
+def link_mask(image: np.ndarray) -> np.ndarray:
+    """The pixels in the warm tan/orange of the pantograph links (LINK_COLOURS of
     hexadyn.view.scene, whatever their shading); the grey ground and the GUI have none."""
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
-    return float(np.mean((r - b > 0.25) & (g > 0.3) & (r > 0.5)))
+    return (r - b > 0.25) & (g > 0.3) & (r > 0.5)
+
+
+def link_share(image: np.ndarray) -> float:
+    return float(np.mean(link_mask(image)))
+
+
+def link_centre(image: np.ndarray) -> np.ndarray:
+    """Where the links are drawn: the centroid (row, column) of their pixels."""
+    return np.argwhere(link_mask(image)).mean(axis=0)
 
 
 def assert_scene_drawn(image: np.ndarray, what: str) -> None:
@@ -237,11 +246,20 @@ def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder,
     page.close()
 
 
-def test_view_html_export_plays_from_a_static_server_and_a_file_url(walk_folder, browser, tmp_path):
+def test_view_html_export_plays_from_a_static_server_and_a_file_url(walk_folder, live, browser, tmp_path):
     export = tmp_path / "site" / "walk.html"
     result = CliRunner().invoke(cli, ["view", str(walk_folder), "--html", str(export)])
     assert result.exit_code == 0, result.output
     assert export.is_file() and "__VISER_EMBED_DATA__" in export.read_text()
+
+    # The live page at the start, seen from the same initial camera, for comparison.
+    live.viewer.seek(0.0)
+    page = browser.new_page(viewport=VIEWPORT)
+    page.goto(live.url)
+    page.wait_for_selector("#hexadyn-state", state="attached", timeout=30000)
+    time.sleep(2.0)
+    live_links = link_centre(canvas_png(page, tmp_path / "live.png"))
+    page.close()
 
     handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(export.parent))
     handler.log_message = lambda *a: None  # type: ignore[attr-defined]
@@ -254,7 +272,10 @@ def test_view_html_export_plays_from_a_static_server_and_a_file_url(walk_folder,
             page.wait_for_selector("canvas", timeout=30000)
             time_box = page.locator("input[type=text]").first
             wait_for(lambda: time_box.count() and float(time_box.input_value() or 0) > 0.5, what=f"{url} to play")
-            assert_scene_drawn(canvas_png(page, tmp_path / "export.png"), url)
+            image = canvas_png(page, tmp_path / "export.png")
+            assert_scene_drawn(image, url)
+            # The same scene: the robot where the live page draws it (it walks 1.5 cm/s).
+            assert np.abs(link_centre(image) - live_links).max() < 60, (link_centre(image), live_links)
             page.close()
     finally:
         httpd.shutdown()
