@@ -34,7 +34,9 @@ $(PY):
 	$(PYTHON) -m venv $(VENV)
 
 # Pinned dependencies and the editable install (pip runs maturin, which builds _core in release).
+# The viewer's browser tests drive Debian's chromium (Playwright cannot download its own here).
 $(DEPS_STAMP): $(LOCK) pyproject.toml | $(PY)
+	command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium; }
 	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) maturin
 	PATH="$(abspath $(VENV))/bin:$$PATH" \
 	  $(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) --no-build-isolation -e '.[test]'

@@ -296,6 +296,11 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_add
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
 
 
+from hexadyn.view.command import view  # noqa: E402  (hexadyn view: the 3D animation of a results folder)
+
+cli.add_command(view)
+
+
 def _free_folder(base: Path) -> Path:
     """`base`, or `base-2`, `base-3`... whichever does not exist yet."""
     if not base.exists():

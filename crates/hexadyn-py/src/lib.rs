@@ -6,6 +6,7 @@ mod mbs;
 mod monte_carlo;
 mod scenario;
 mod schema;
+mod view;
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -16,5 +17,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
     schema::register(m)?;
+    m.add_class::<view::PyKinematics>()?;
     Ok(())
 }
