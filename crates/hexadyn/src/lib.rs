@@ -25,6 +25,7 @@ pub mod analysis;
 pub mod control;
 pub mod description;
 pub mod hexapod;
+pub mod link;
 pub mod mbs;
 pub mod physics;
 pub mod robot;
