@@ -123,10 +123,12 @@ use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel};
 use crate::robot::recorder::{Recorder, TimeSeries};
 use crate::robot::simulation::{run_until, PlantOptions, SimulatedRobot};
 
+mod drivers;
 mod gait;
 mod joint_friction;
 mod overrides;
 pub use overrides::Override;
+pub use drivers::{settled_robot, GaitColumns, ScenarioController};
 pub use gait::{phase_code, GaitChange, GaitScenario, GaitSummary, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 use crate::control::{joint_pis, Command, Controller, JointMotion, JointPiController, JointReferences, Measurements, Unpowered};
 use crate::physics::FlatGround;
