@@ -292,9 +292,8 @@ impl Master {
             self.period += 1;
         }
         let bytes: [u8; COMMAND_SIZE] = MotorCommands { seq: self.period as u16, duties: *duties }.encode();
-        let sent = self.socket.send_to(&bytes, self.config.broadcast);
         let now = Instant::now();
-        sent.map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
+        self.socket.send_to(&bytes, self.config.broadcast).map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
         let deadline = self.next_deadline;
         self.stats.lateness.push(now.saturating_duration_since(deadline).as_secs_f64());
         self.stats.broadcasts += 1;
