@@ -316,5 +316,9 @@ def _one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+from hexadyn.link.cli import robot  # noqa: E402  (the `hexadyn robot` commands)
+
+cli.add_command(robot)
+
 if __name__ == "__main__":  # pragma: no cover
     main()

@@ -2,6 +2,7 @@
 
 use pyo3::prelude::*;
 
+mod link;
 mod mbs;
 mod monte_carlo;
 mod scenario;
@@ -14,5 +15,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
+    m.add_function(wrap_pyfunction!(link::encode_command, m)?)?;
+    m.add_function(wrap_pyfunction!(link::decode_command, m)?)?;
+    m.add_function(wrap_pyfunction!(link::encode_reply, m)?)?;
+    m.add_function(wrap_pyfunction!(link::decode_reply, m)?)?;
+    m.add_function(wrap_pyfunction!(link::robot_run, m)?)?;
+    m.add_function(wrap_pyfunction!(link::robot_emulate, m)?)?;
     Ok(())
 }

@@ -17,7 +17,9 @@
 //!    real robot;
 //! 8. [`robot`]: the complete model as one residual system and the simulated robot (Chapter 3);
 //! 9. [`scenario`]: ready-to-run simulations from TOML files, their run and summary;
-//! 10. [`analysis`]: controller design from the model (Section 4.4).
+//! 10. [`analysis`]: controller design from the model (Section 4.4);
+//! 11. [`link`]: the master/slave UDP link to the real robot, its slave emulator on the
+//!     simulated robot, and scenarios run through it (Section 2.3.2).
 //!
 //! `control` never imports `robot`: a controller sees only what the real robot measures.
 

@@ -22,6 +22,8 @@
 //! [safety]
 //! missing_periods = 3                  # a slave silent this many periods in a row stops the robot
 //! connect_timeout_s = 5.0              # the six slaves must answer within this at the start
+//! overrun_tolerance_s = 0.0            # a command ready later than this after its deadline
+//!                                      #   is a controller overrun (stop)
 //! ```
 
 use std::net::{Ipv4Addr, SocketAddr, SocketAddrV4};
@@ -92,12 +94,13 @@ impl Default for RawTiming {
 struct RawSafety {
     missing_periods: i64,
     connect_timeout_s: f64,
+    overrun_tolerance_s: f64,
 }
 
 impl Default for RawSafety {
     fn default() -> Self {
         let s = Safety::default();
-        RawSafety { missing_periods: i64::from(s.missing_periods), connect_timeout_s: s.connect_timeout.as_secs_f64() }
+        RawSafety { missing_periods: i64::from(s.missing_periods), connect_timeout_s: s.connect_timeout.as_secs_f64(), overrun_tolerance_s: s.overrun_tolerance.as_secs_f64() }
     }
 }
 
@@ -137,11 +140,14 @@ pub struct Safety {
     pub missing_periods: u32,
     /// At the start, the six slaves must answer within this time.
     pub connect_timeout: Duration,
+    /// A controller command ready later than this after its deadline is an overrun (0: any
+    /// lateness); within it, the command is broadcast late.
+    pub overrun_tolerance: Duration,
 }
 
 impl Default for Safety {
     fn default() -> Self {
-        Safety { missing_periods: 3, connect_timeout: Duration::from_secs(5) }
+        Safety { missing_periods: 3, connect_timeout: Duration::from_secs(5), overrun_tolerance: Duration::ZERO }
     }
 }
 
@@ -237,6 +243,7 @@ fn validate(raw: &RawConfig, c: &Ctx) -> Result<LinkConfig, DescriptionError> {
         return Err(c.err("safety.missing_periods", r.missing_periods, "out of range", "a number of periods 1..1000 (3 by default)"));
     }
     c.check(r.connect_timeout_s > 0.0 && r.connect_timeout_s <= 3600.0, "safety.connect_timeout_s", r.connect_timeout_s, "a time in (0, 3600] s")?;
+    c.check(r.overrun_tolerance_s >= 0.0 && r.overrun_tolerance_s < t.period_s, "safety.overrun_tolerance_s", r.overrun_tolerance_s, "a time in [0, period_s) s")?;
     Ok(LinkConfig {
         master,
         broadcast,
@@ -248,7 +255,7 @@ fn validate(raw: &RawConfig, c: &Ctx) -> Result<LinkConfig, DescriptionError> {
             spin: Duration::from_secs_f64(t.spin_s),
             realtime_priority: (t.realtime_priority > 0).then_some(t.realtime_priority as u8),
         },
-        safety: Safety { missing_periods: r.missing_periods as u32, connect_timeout: Duration::from_secs_f64(r.connect_timeout_s) },
+        safety: Safety { missing_periods: r.missing_periods as u32, connect_timeout: Duration::from_secs_f64(r.connect_timeout_s), overrun_tolerance: Duration::from_secs_f64(r.overrun_tolerance_s) },
         origin: c.file.to_string(),
     })
 }

@@ -241,7 +241,7 @@ impl Master {
     /// controller's command is ready.
     pub fn check_overrun(&mut self) -> Result<(), LinkError> {
         let now = Instant::now();
-        if self.started && now > self.next_deadline {
+        if self.started && now > self.next_deadline + self.config.safety.overrun_tolerance {
             let late_s = (now - self.next_deadline).as_secs_f64();
             return Err(self.safety_stop(StopReason::Overrun { late_s }));
         }
@@ -268,6 +268,15 @@ impl Master {
             if let Err(e) = self.socket.send_to(&bytes, self.config.broadcast) {
                 self.event(format!("the stop command could not be sent: {e}"));
             }
+        }
+    }
+
+    /// Reads and counts what still arrives during `duration` (after a stop: the slaves' late
+    /// packets and their answers to the stop command), so that the counters see every packet.
+    pub fn linger(&mut self, duration: Duration) {
+        let until = Instant::now() + duration;
+        while let Ok(Wake::Readable) = self.poll(until) {
+            self.drain();
         }
     }
 

@@ -27,7 +27,7 @@ mod udp_plant;
 
 pub use config::{ConfigError, LinkConfig, Safety, Timing};
 pub use master::{SafetyStop, StopReason};
-pub use udp_plant::UdpPlant;
+pub use udp_plant::{MissedPeriod, UdpPlant};
 
 use crate::scenario::ScenarioError;
 

@@ -3,7 +3,8 @@
 //! [`ScenarioController`], on the [`UdpPlant`] instead of the simulated robot, on a dedicated
 //! thread (real-time when the configuration asks for it).
 //!
-//! One row per controller update, what the master saw:
+//! One row per period, what the master saw (a missed period has NaN measurements and
+//! references):
 //!
 //! | columns | unit | |
 //! | --- | --- | --- |
@@ -21,7 +22,9 @@
 //! | `last_reply` | s | when the last slave packet of the period arrived after the broadcast |
 //! | `missed_periods` | 1 | periods missed so far (a slave packet missing at the deadline) |
 //!
-//! A safety stop ends the run early with the rows up to it; the summary says why
+//! The run makes as many controller updates as the simulation of the scenario; each missed
+//! period (no update) adds a period, so the last row's t exceeds the duration by the missed
+//! periods. A safety stop ends the run early with the rows up to it; the summary says why
 //! (`safety_stop`).
 
 use std::ops::ControlFlow;
@@ -140,6 +143,9 @@ fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interru
     let resistance = s.robot.circuit_resistance_ohm();
     let mut row = Row { rec: Recorder::default(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
     let mut plant = UdpPlant::connect(config, &s.robot, interrupt)?;
+    // As many controller updates as in a simulation: the controllers count their updates (the
+    // gait integrates its body reference by Δt per update), so a missed period, which runs no
+    // update, lengthens the run by one period.
     let outcome = run_until(&mut plant, &mut controller, s.duration, |p, m, cmd| {
         row.record(p, m, cmd);
         periods.store((m.t / s.period()).round() as u64, Ordering::Relaxed);
@@ -154,6 +160,20 @@ fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interru
     stats.realtime = realtime;
     let summary = row.summary(s, &stats, &controller_time, stop.as_ref(), started.elapsed().as_secs_f64());
     Ok(RobotRun { series: row.rec.finish(), summary, stop, stats, events })
+}
+
+/// What one row holds.
+struct Sample<'a> {
+    t: f64,
+    period: u64,
+    positions: &'a [f64; JOINTS],
+    references: &'a [f64; JOINTS],
+    voltages: &'a [f64; JOINTS],
+    currents: &'a [f64; JOINTS],
+    supply: f64,
+    lateness: f64,
+    last_reply: f64,
+    missed: u64,
 }
 
 /// The recorder of a run and the totals it keeps.
@@ -185,6 +205,10 @@ fn joint_unit(k: usize, rotational: &'static str, linear: &'static str) -> &'sta
 
 impl Row {
     fn record(&mut self, p: &UdpPlant, m: &Measurements, cmd: &Command) {
+        let nan = [f64::NAN; JOINTS];
+        for missed in p.missed() {
+            self.put(&Sample { t: missed.t, period: missed.period, positions: &nan, references: &nan, voltages: &missed.voltages, currents: &nan, supply: f64::NAN, lateness: missed.lateness, last_reply: f64::NAN, missed: p.stats().missed_periods });
+        }
         let u = p.held_voltages();
         let dt = self.last_t.map_or(0.0, |t| m.t - t);
         self.last_t = Some(m.t);
@@ -200,27 +224,34 @@ impl Row {
                 self.tracking[k % 3] = self.tracking[k % 3].max((cmd.references[k] - m.positions[k]).abs());
             }
         }
+        self.put(&Sample { t: m.t, period: p.period_index(), positions: &m.positions, references: &cmd.references, voltages: &u, currents: &m.currents, supply: m.supply_voltage, lateness: p.lateness(), last_reply: p.last_reply(), missed: p.stats().missed_periods });
+    }
+
+    /// One row. A missed period gets a row too (NaN where nothing was measured, the energies
+    /// carried over, the gait columns of the last update) so that the rows stay one period
+    /// apart.
+    fn put(&mut self, x: &Sample) {
         let s = |x: &str| x.to_string();
         let rec = &mut self.rec;
         rec.begin_row();
-        rec.put(m.t, || (s("t"), "s", s("control instant: period index times the control period")));
-        rec.put(p.period_index() as f64, || (s("period"), "1", s("period index (the command's sequence number modulo 2^16)")));
+        rec.put(x.t, || (s("t"), "s", s("control instant: period index times the control period")));
+        rec.put(x.period as f64, || (s("period"), "1", s("period index (the command's sequence number modulo 2^16)")));
         for k in 0..JOINTS {
-            rec.put(m.positions[k], || (joint_name("", k, ""), joint_unit(k, "rad", "m"), format!("encoder position, leg {}", k / 3)));
+            rec.put(x.positions[k], || (joint_name("", k, ""), joint_unit(k, "rad", "m"), format!("encoder position, leg {} (NaN: period missed)", k / 3)));
         }
         if self.pi {
             for k in 0..JOINTS {
-                rec.put(cmd.references[k], || (joint_name("", k, "_ref"), joint_unit(k, "rad", "m"), format!("PI reference computed at t, leg {}", k / 3)));
+                rec.put(x.references[k], || (joint_name("", k, "_ref"), joint_unit(k, "rad", "m"), format!("PI reference computed at t, leg {} (NaN: period missed)", k / 3)));
             }
         }
         self.gait.record(rec);
         for k in 0..JOINTS {
-            rec.put(u[k], || (joint_name("u_", k, ""), "V", s("voltage held over the period ending at t: PWM duty / 1023 times the board's supply")));
+            rec.put(x.voltages[k], || (joint_name("u_", k, ""), "V", s("voltage held over the period ending at t: PWM duty / 1023 times the board's supply")));
         }
         for k in 0..JOINTS {
-            rec.put(m.currents[k], || (joint_name("i_", k, ""), "A", s("motor current measured by the slave board")));
+            rec.put(x.currents[k], || (joint_name("i_", k, ""), "A", s("motor current measured by the slave board (NaN: period missed)")));
         }
-        rec.put(m.supply_voltage, || (s("u_supply"), "V", s("lowest supply voltage measured by the six boards")));
+        rec.put(x.supply, || (s("u_supply"), "V", s("lowest supply voltage measured by the six boards")));
         for k in 0..JOINTS {
             rec.put(self.e_el[k], || (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy of the samples, sum of u i dt")));
         }
@@ -230,15 +261,16 @@ impl Row {
         for k in 0..JOINTS {
             rec.put(f64::NAN, || (joint_name("E_fric_", k, ""), "J", s("friction work: not measured on the robot (NaN)")));
         }
-        rec.put(p.lateness(), || (s("lateness"), "s", s("lateness of the period's broadcast against its deadline")));
-        rec.put(p.last_reply(), || (s("last_reply"), "s", s("arrival of the period's last slave packet after the broadcast")));
-        rec.put(p.stats().missed_periods as f64, || (s("missed_periods"), "1", s("periods missed so far (a slave packet missing at the deadline)")));
+        rec.put(x.lateness, || (s("lateness"), "s", s("lateness of the period's broadcast against its deadline")));
+        rec.put(x.last_reply, || (s("last_reply"), "s", s("arrival of the period's last slave packet after the broadcast (NaN: period missed)")));
+        rec.put(x.missed as f64, || (s("missed_periods"), "1", s("periods missed so far (a slave packet missing at the deadline)")));
         rec.end_row();
     }
 
     fn summary(&self, s: &Scenario, stats: &LinkStats, controller_time: &[f64], stop: Option<&SafetyStop>, wall: f64) -> Vec<(&'static str, SummaryValue)> {
         use SummaryValue::{Count, Number, Text};
         let rows = self.rec.rows() as u64;
+        // Rows of missed periods included: one row per period.
         let duration = self.last_t.unwrap_or(0.0);
         let energy: f64 = self.e_el.iter().sum();
         let lateness = Percentiles::of(&stats.lateness);

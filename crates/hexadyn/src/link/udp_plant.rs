@@ -26,6 +26,17 @@ use crate::control::{Command, Encoder, Measurements, Plant};
 use crate::description::RobotDescription;
 use crate::hexapod::{Joint, JOINTS, LEG_COUNT};
 
+/// A period whose slave packets did not all arrive: no measurements, the controller did not run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MissedPeriod {
+    pub t: f64,
+    pub period: u64,
+    /// The voltages held over the period that ended then (the last supplies measured).
+    pub voltages: [f64; JOINTS],
+    /// Lateness of its broadcast (s).
+    pub lateness: f64,
+}
+
 /// The robot behind the master/slave link.
 pub struct UdpPlant {
     master: Master,
@@ -41,6 +52,8 @@ pub struct UdpPlant {
     ready_at: Instant,
     /// The period of the first measurements: t = 0 there.
     origin: u64,
+    /// The periods missed just before the current measurements.
+    missed: Vec<MissedPeriod>,
     /// Time from the last packet of a period to the controller's command (controller and
     /// recording), per complete period (s).
     pub controller_time: Vec<f64>,
@@ -66,6 +79,7 @@ impl UdpPlant {
             held: [Duty::ZERO; JOINTS],
             ready_at: Instant::now(),
             origin: 0,
+            missed: Vec::new(),
             controller_time: Vec::new(),
             interrupt,
         };
@@ -86,6 +100,11 @@ impl UdpPlant {
         m.supply_voltage = replies.iter().map(SlaveReply::supply_voltage).fold(f64::INFINITY, f64::min);
         m.pose = None;
         self.ready_at = Instant::now();
+    }
+
+    /// The periods missed just before the current measurements, in order.
+    pub fn missed(&self) -> &[MissedPeriod] {
+        &self.missed
     }
 
     /// Index of the period of the current measurements.
@@ -122,9 +141,11 @@ impl UdpPlant {
         self.master.stats.lateness.last().copied().unwrap_or(0.0)
     }
 
-    /// Puts every motor to 0 V (the end of a run) and returns what the master counted.
+    /// Puts every motor to 0 V (the end of a run), counts what arrives during one more period,
+    /// and returns what the master counted.
     pub fn finish(mut self) -> (LinkStats, Vec<LinkEvent>, Vec<f64>) {
         self.master.stop();
+        self.master.linger(self.master.config().timing.period);
         (std::mem::take(&mut self.master.stats), std::mem::take(&mut self.master.events), std::mem::take(&mut self.controller_time))
     }
 }
@@ -151,6 +172,7 @@ impl Plant for UdpPlant {
         }
         self.master.check_overrun()?;
         let duties = self.next;
+        self.missed.clear();
         loop {
             let outcome = self.master.run_period(&duties);
             self.held = self.broadcast;
@@ -159,6 +181,8 @@ impl Plant for UdpPlant {
                 self.accept(replies);
                 return Ok(());
             }
+            let period = self.master.period();
+            self.missed.push(MissedPeriod { t: (period - self.origin) as f64 * self.dt, period, voltages: self.held_voltages(), lateness: self.lateness() });
             if self.interrupt.load(Ordering::Relaxed) {
                 return Err(self.master.safety_stop(StopReason::Interrupted));
             }
