@@ -12,6 +12,7 @@ from pathlib import Path
 import click
 
 import hexadyn
+from hexadyn.runner import free_results_folder
 
 #: Scenario run by `hexadyn simulate` without an argument (and by `make run`): a shipped scenario
 #: name or a path. The validation test case of Table 6.2 (tripod, T = 12 s, 5 steps, 5 % overlap)
@@ -19,7 +20,6 @@ import hexadyn
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 
 #: Folder under which `hexadyn simulate` writes results when no --out is given.
-RESULTS_ROOT = Path("results")
 
 # Exceptions that report bad input (a missing file, a wrong value in a scenario) rather than a
 # bug: they are shown as one clean line.
@@ -115,7 +115,7 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
     # Validate before anything is created: a bad scenario leaves no results folder behind.
     info = _core.load_scenario(str(path))
     if out is None:
-        out = _free_folder(RESULTS_ROOT / info["name"])
+        out = free_results_folder(info["name"])
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
     results = hexadyn.simulate(path, progress=not no_progress)
@@ -209,7 +209,7 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
 
     path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
     if out is None:
-        out = _free_folder(RESULTS_ROOT / f"compare_friction_{path.stem}")
+        out = free_results_folder(f"compare_friction_{path.stem}")
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the output folder exists; use --overwrite or another --out")
     names = list(compare.MODELS) if models is None else [m.strip() for m in models.split(",") if m.strip()]
@@ -301,16 +301,6 @@ from hexadyn.view.command import view  # noqa: E402  (hexadyn view: the 3D anima
 cli.add_command(view)
 
 
-def _free_folder(base: Path) -> Path:
-    """`base`, or `base-2`, `base-3`... whichever does not exist yet."""
-    if not base.exists():
-        return base
-    n = 2
-    while (candidate := base.with_name(f"{base.name}-{n}")).exists():
-        n += 1
-    return candidate
-
-
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``hexadyn`` console script."""
     cli.main(args=argv, prog_name="hexadyn")
@@ -322,6 +312,10 @@ def _one_line(exc: BaseException) -> str:
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
 
+
+from hexadyn.link.cli import robot  # noqa: E402  (the `hexadyn robot` commands)
+
+cli.add_command(robot)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

@@ -110,3 +110,18 @@ def _run_with_bar(core, path: Path, overrides: dict | None) -> dict:
         raw = core.run_scenario(os.fspath(path), update, overrides)
         bar.update(duration - bar.n)  # the last instant is duration up to rounding
     return raw
+
+
+#: Where the commands put results folders when no ``--out`` is given.
+RESULTS_ROOT = Path("results")
+
+
+def free_results_folder(name: str) -> Path:
+    """``results/<name>``, or ``results/<name>-2``, ``-3``... whichever does not exist yet."""
+    base = RESULTS_ROOT / name
+    if not base.exists():
+        return base
+    n = 2
+    while (candidate := base.with_name(f"{base.name}-{n}")).exists():
+        n += 1
+    return candidate

@@ -16,7 +16,7 @@ fn value_error(e: ScenarioError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-fn load(path: &PathBuf, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Scenario> {
+pub(crate) fn load(path: &PathBuf, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<Scenario> {
     let overrides = match overrides {
         Some(d) => d.iter().map(|(k, v)| {
             let field: String = k.extract().map_err(|_| PyTypeError::new_err(format!("override names are dotted field strings, not {k:?}")))?;

@@ -19,7 +19,9 @@
 //!    real robot;
 //! 9. [`robot`]: the complete model as one residual system and the simulated robot (Chapter 3);
 //! 10. [`scenario`]: ready-to-run simulations from TOML files, their run and summary;
-//! 11. [`analysis`]: controller design from the model (Section 4.4).
+//! 11. [`analysis`]: controller design from the model (Section 4.4);
+//! 12. [`link`]: the master/slave UDP link to the real robot, its slave emulator on the
+//!     simulated robot, and scenarios run through it (Section 2.3.2).
 //!
 //! `control` never imports `robot`: a controller sees only what the real robot measures.
 
@@ -28,6 +30,7 @@ pub mod control;
 pub mod description;
 pub mod fields;
 pub mod hexapod;
+pub mod link;
 pub mod mbs;
 pub mod physics;
 pub mod robot;

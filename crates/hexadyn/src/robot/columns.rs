@@ -131,7 +131,7 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
 
 /// The gait controller's columns: desired body pose and velocities, duty factor, foot phases
 /// and foot references.
-fn record_gait(rec: &mut Recorder, g: &GaitState) {
+pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
     let s = |x: &str| x.to_string();
     let pose = [g.pose.position.x, g.pose.position.y, g.pose.position.z, g.pose.angles.x, g.pose.angles.y, g.pose.angles.z];
     const POSE: [(&str, &str); 6] = [("X_ref", "m"), ("Y_ref", "m"), ("Z_ref", "m"), ("yaw_ref", "rad"), ("pitch_ref", "rad"), ("roll_ref", "rad")];

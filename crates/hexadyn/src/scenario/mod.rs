@@ -48,6 +48,7 @@ use crate::robot::model::ModelOptions;
 use crate::robot::simulation::PlantOptions;
 use crate::sim::SimError;
 
+mod drivers;
 mod file;
 mod gait;
 mod joint_friction;
@@ -58,6 +59,7 @@ mod summary;
 pub use crate::control::gait::schedule::GaitChange;
 pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
+pub use drivers::{settled_robot, GaitColumns, ScenarioController};
 pub use run::{run_scenario, run_scenario_until, Record, ScenarioResults};
 pub use summary::{specific_resistance, GaitSummary, Summary, SummaryValue};
 

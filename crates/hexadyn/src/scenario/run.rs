@@ -50,9 +50,8 @@ pub fn run_scenario(s: &Scenario, mut progress: impl FnMut(f64)) -> Result<Scena
 pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
     let started = Instant::now();
     let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
-    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
-    let (q, qd) = initial_state(s, &model)?;
-    let mut plant = SimulatedRobot::new(model.clone(), &q, &qd, &s.plant).map_err(sim_err("the start"))?;
+    let mut plant = settled_robot(s)?;
+    let q = plant.state().q.as_slice().to_vec();
     let (mut controller, gait_state) = controller(s);
 
     // The joint references are recorded and tracked by the PI loops in these modes.
@@ -89,9 +88,11 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
     Ok(ScenarioResults { series, summary })
 }
 
-/// The start (q, q'): feet on the ground, static equilibrium with the joints locked (Section
-/// 6.2) unless `initial.settle` is off, then the body raised by `initial.body_height_offset`.
-fn initial_state(s: &Scenario, model: &Arc<RobotModel>) -> Result<(Vec<f64>, Vec<f64>)> {
+/// The simulated robot at the start: feet on the ground, static equilibrium with the joints
+/// locked (Section 6.2) unless `initial.settle` is off, then the body raised by
+/// `initial.body_height_offset`.
+pub(super) fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
+    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
     let mut q = model.touching_ground(&s.initial.joints);
     let mut qd = vec![0.0; q.len()];
     if s.initial.settle {
@@ -109,12 +110,12 @@ fn initial_state(s: &Scenario, model: &Arc<RobotModel>) -> Result<(Vec<f64>, Vec
         }
     }
     q[2] += s.initial.body_height_offset;
-    Ok((q, qd))
+    SimulatedRobot::new(model, &q, &qd, &s.plant).map_err(|source| ScenarioError::Simulation { file: s.origin.clone(), stage: "the start", source, hint: "" })
 }
 
 /// The controller of the scenario's control mode and, walking, the state the gait controller
 /// publishes after each update.
-fn controller(s: &Scenario) -> (Box<dyn Controller>, Option<Rc<RefCell<GaitState>>>) {
+pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Option<Rc<RefCell<GaitState>>>) {
     match s.control {
         ControlMode::Gait => {
             let g = s.gait.as_ref().expect("gait mode has a validated [gait]");

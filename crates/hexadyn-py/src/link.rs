@@ -1,0 +1,206 @@
+//! The robot link (`hexadyn.link`): the packet codecs (for the Python mirror and tools), a
+//! scenario run on the robot through the master (`robot_run`) and the slave emulator
+//! (`robot_emulate`). Both block without the GIL and check for Ctrl-C every 100 ms.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use hexadyn::link::emulator::{Emulator, EmulatorOptions};
+use hexadyn::link::faults::Faults;
+use hexadyn::link::protocol::{Duty, MotorCommands, SlaveReply};
+use hexadyn::link::run::spawn_robot_run;
+use hexadyn::link::LinkConfig;
+use hexadyn::scenario::SummaryValue;
+use numpy::PyArray1;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+
+use crate::scenario::load;
+
+const POLL: Duration = Duration::from_millis(100);
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+fn config(path: &PathBuf) -> PyResult<LinkConfig> {
+    LinkConfig::from_file(path).map_err(value_error)
+}
+
+/// The 36-byte command packet of sequence number `seq` with 18 signed duties (-1023..1023).
+#[pyfunction]
+pub fn encode_command<'py>(py: Python<'py>, seq: u16, duties: Vec<i16>) -> PyResult<Bound<'py, PyBytes>> {
+    let duties: Vec<Duty> = duties.iter().map(|&d| Duty::new(d).ok_or_else(|| value_error(format!("duty {d}: allowed -1023..1023")))).collect::<PyResult<_>>()?;
+    let duties: [Duty; 18] = duties.try_into().map_err(|d: Vec<Duty>| value_error(format!("{} duties: allowed 18", d.len())))?;
+    Ok(PyBytes::new(py, &MotorCommands { seq, duties }.encode()))
+}
+
+/// Decodes a command packet: (seq, duties); ValueError naming why it is rejected.
+#[pyfunction]
+pub fn decode_command(data: &[u8]) -> PyResult<(u16, Vec<i16>)> {
+    let c = MotorCommands::decode(data).map_err(value_error)?;
+    Ok((c.seq, c.duties.iter().map(|d| d.get()).collect()))
+}
+
+/// The 20-byte slave packet (fields saturated to their ranges as a board's counters and A/D
+/// converters are; `leg` modulo 6).
+#[pyfunction]
+pub fn encode_reply<'py>(py: Python<'py>, leg: u8, seq: u16, counts: [i32; 3], currents_ma: [i16; 3], supply: u8) -> Bound<'py, PyBytes> {
+    PyBytes::new(py, &SlaveReply { leg, seq, counts, currents_ma, supply }.encode())
+}
+
+/// Decodes a slave packet: (leg, seq, counts, currents_ma, supply); ValueError naming why it is
+/// rejected.
+#[pyfunction]
+pub fn decode_reply(data: &[u8]) -> PyResult<(u8, u16, [i32; 3], [i16; 3], u8)> {
+    let r = SlaveReply::decode(data).map_err(value_error)?;
+    Ok((r.leg, r.seq, r.counts, r.currents_ma, r.supply))
+}
+
+fn summary_dict<'py>(py: Python<'py>, entries: Vec<(&'static str, SummaryValue)>) -> PyResult<Bound<'py, PyDict>> {
+    let summary = PyDict::new(py);
+    for (name, value) in entries {
+        match value {
+            SummaryValue::Text(s) => summary.set_item(name, s)?,
+            SummaryValue::Count(n) => summary.set_item(name, n)?,
+            SummaryValue::Number(x) => summary.set_item(name, x)?,
+        }
+    }
+    Ok(summary)
+}
+
+/// Runs the scenario's controller on the robot through the link configured in `link` and
+/// returns the dict of `run_scenario` ("columns", "units", "descriptions", "summary",
+/// "scenario", "robot", "robot_source") plus "events" (the dropped packets and missed periods
+/// the master logged, as (period, message)) and "stop" (the safety stop, or None). Ctrl-C
+/// stops the robot at the next period (0 V) and returns what was recorded. `progress(t_s,
+/// duration_s)` is called every 100 ms. Raises ValueError for invalid files, a scenario that
+/// does not fit the link, or slaves that do not answer.
+#[pyfunction]
+#[pyo3(signature = (scenario, link, progress = None, overrides = None))]
+pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progress: Option<Py<PyAny>>, overrides: Option<Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
+    let s = load(&scenario, overrides.as_ref())?;
+    let config = config(&link)?;
+    let (text, robot, robot_source, duration) = (s.text.clone(), s.robot_text.clone(), s.robot_source.clone(), s.duration);
+    let handle = spawn_robot_run(s, config).map_err(value_error)?;
+    let mut python_error = None;
+    while !handle.is_finished() {
+        py.detach(|| std::thread::sleep(POLL));
+        let called = py.check_signals().and_then(|()| match &progress {
+            Some(f) => f.call1(py, (handle.t(), duration)).map(|_| ()),
+            None => Ok(()),
+        });
+        if let Err(e) = called {
+            handle.interrupt();
+            if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+                python_error = Some(e);
+            }
+        }
+    }
+    let run = py.detach(|| handle.join()).map_err(value_error)?;
+    if let Some(e) = python_error {
+        return Err(e);
+    }
+    let (columns, units, descriptions) = (PyDict::new(py), PyDict::new(py), PyDict::new(py));
+    for c in run.series.columns {
+        units.set_item(&c.name, c.unit)?;
+        descriptions.set_item(&c.name, &c.description)?;
+        columns.set_item(&c.name, PyArray1::from_vec(py, c.values))?;
+    }
+    let d = PyDict::new(py);
+    d.set_item("columns", columns)?;
+    d.set_item("units", units)?;
+    d.set_item("descriptions", descriptions)?;
+    d.set_item("summary", summary_dict(py, run.summary)?)?;
+    d.set_item("scenario", text)?;
+    d.set_item("robot", robot)?;
+    d.set_item("robot_source", robot_source)?;
+    d.set_item("events", run.events.into_iter().map(|e| (e.period, e.message)).collect::<Vec<_>>())?;
+    d.set_item("stop", run.stop.map(|s| s.to_string()))?;
+    Ok(d)
+}
+
+/// Emulates the six slave boards on the scenario's simulated robot with the link configured in
+/// `link`, until Ctrl-C or `idle_timeout_s` without a command after the first one (None: until
+/// Ctrl-C). `faults` maps fault names to values: loss, duplicate, reorder, corrupt,
+/// wrong_size (probabilities), delay_s, jitter_s, max_consecutive (int), silent_slave
+/// (leg, after_commands) and seed. `ready()` is called once the slaves listen. Returns the
+/// report as a dict.
+#[pyfunction]
+#[pyo3(signature = (scenario, link, faults = None, idle_timeout_s = None, ready = None, overrides = None))]
+pub fn robot_emulate<'py>(
+    py: Python<'py>,
+    scenario: PathBuf,
+    link: PathBuf,
+    faults: Option<Bound<'py, PyDict>>,
+    idle_timeout_s: Option<f64>,
+    ready: Option<Py<PyAny>>,
+    overrides: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = load(&scenario, overrides.as_ref())?;
+    let config = config(&link)?;
+    let faults = faults_from(faults.as_ref())?;
+    let idle_timeout = idle_timeout_s.map(|t| if t.is_finite() && t > 0.0 { Ok(Duration::from_secs_f64(t)) } else { Err(value_error(format!("idle timeout {t} s: allowed a time > 0"))) }).transpose()?;
+    let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { faults, idle_timeout, history: false })).map_err(value_error)?;
+    if let Some(f) = ready {
+        f.call0(py)?;
+    }
+    let mut interrupted = None;
+    while !emulator.is_finished() {
+        py.detach(|| std::thread::sleep(POLL));
+        if let Err(e) = py.check_signals() {
+            interrupted = Some(e);
+            break;
+        }
+    }
+    let report = py.detach(|| emulator.wait(&AtomicBool::new(true)));
+    let d = PyDict::new(py);
+    d.set_item("commands", report.commands)?;
+    d.set_item("sent", report.sent)?;
+    d.set_item("ignored", report.ignored)?;
+    d.set_item("rejected", report.rejected.total())?;
+    let f = report.faults;
+    let fd = PyDict::new(py);
+    for (k, v) in [("lost", f.lost), ("silenced", f.silenced), ("duplicated", f.duplicated), ("reordered", f.reordered), ("corrupted", f.corrupted), ("wrong_size", f.wrong_size)] {
+        fd.set_item(k, v)?;
+    }
+    d.set_item("faults", fd)?;
+    d.set_item("t", report.t)?;
+    d.set_item("body", report.body.to_vec())?;
+    d.set_item("step_time_p99_s", report.step_time.p99)?;
+    d.set_item("step_time_max_s", report.step_time.max)?;
+    d.set_item("realtime", report.realtime)?;
+    d.set_item("error", report.error)?;
+    d.set_item("interrupted", interrupted.is_some())?;
+    Ok(d)
+}
+
+fn faults_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<Faults> {
+    let mut f = Faults::default();
+    let Some(d) = d else { return Ok(f) };
+    for (k, v) in d.iter() {
+        let key: String = k.extract()?;
+        let bad = |allowed: &str| value_error(format!("fault {key} = {v}: allowed {allowed}"));
+        let seconds = |v: &Bound<'_, PyAny>| -> PyResult<Duration> {
+            let x: f64 = v.extract()?;
+            if x.is_finite() && x >= 0.0 { Ok(Duration::from_secs_f64(x)) } else { Err(bad("a time >= 0 s")) }
+        };
+        match key.as_str() {
+            "loss" => f.loss = v.extract()?,
+            "duplicate" => f.duplicate = v.extract()?,
+            "reorder" => f.reorder = v.extract()?,
+            "corrupt" => f.corrupt = v.extract()?,
+            "wrong_size" => f.wrong_size = v.extract()?,
+            "delay_s" => f.delay = seconds(&v)?,
+            "jitter_s" => f.jitter = seconds(&v)?,
+            "max_consecutive" => f.max_consecutive = v.extract()?,
+            "silent_slave" => f.silent_slave = v.extract()?,
+            "seed" => f.seed = v.extract()?,
+            _ => return Err(bad("one of loss, duplicate, reorder, corrupt, wrong_size, delay_s, jitter_s, max_consecutive, silent_slave, seed")),
+        }
+    }
+    f.validate().map_err(value_error)?;
+    Ok(f)
+}

@@ -1,0 +1,338 @@
+//! Six slave boards emulated on the simulated robot, for testing the master and a scenario's
+//! controller without the robot.
+//!
+//! Each command packet is handled as a board does (Section 2.3.2, Fig. 2.19): the boards apply
+//! the 18 duties and latch what they measure at that instant — the encoder counts (500 per
+//! motor revolution), the motor currents and the supply voltage of the simulated AMRU5 — then
+//! the slave of leg l sends its packet t_s0 + l Δt_s after the broadcast (2.5 ms + l × 0.5 ms,
+//! Figs. 2.21-2.22) to the address the command came from. Meanwhile the multiphysics model
+//! advances one control period with the applied voltages (duty / 1023 × its supply). The
+//! currents are those at the end of the previous period (the model has no time between the
+//! PWM update and the A/D conversion).
+//!
+//! Commands that do not decode are counted and ignored; a command numbered like the last one
+//! applied (a duplicate) or up to 255 periods before it (reordered) is ignored too. Faults
+//! ([`super::faults`]) are applied to the outgoing packets.
+//!
+//! Two threads: the model thread receives the commands, latches, schedules the packets and
+//! steps the model; the sender thread sends each packet at its time. With a real-time
+//! priority in the configuration, the sender runs at it and the model thread one below. The
+//! emulator stops on [`Emulator::stop`], or by itself after `idle_timeout` without a command
+//! once the first one came.
+
+use std::collections::BinaryHeap;
+use std::cmp::Reverse;
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use super::clock::{realtime_thread, sleep_until, Percentiles};
+use super::config::LinkConfig;
+use super::faults::{FaultCounts, FaultInjector, Faults, Outgoing};
+use super::protocol::{seq_distance, Duty, MotorCommands, PacketErrorCounts, SlaveReply};
+use super::LinkError;
+use crate::control::{Command, Encoder, Plant};
+use crate::hexapod::{JOINTS, LEG_COUNT};
+use crate::robot::simulation::SimulatedRobot;
+use crate::scenario::{settled_robot, Scenario};
+
+/// How often a blocked thread checks whether it must stop.
+const STOP_POLL: Duration = Duration::from_millis(20);
+/// Commands this many periods (or fewer) before the last one applied are reordered duplicates.
+const REORDER_WINDOW: i32 = 255;
+
+/// Options of an emulator run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EmulatorOptions {
+    pub faults: Faults,
+    /// Stop after this long without a command, once the first came; `None`: run until stopped.
+    pub idle_timeout: Option<Duration>,
+    /// Keep the per-period history (tests and comparisons).
+    pub history: bool,
+}
+
+/// One applied command and what the boards latched when applying it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmulatedPeriod {
+    pub seq: u16,
+    pub duties: [Duty; JOINTS],
+    /// The encoder counts latched, joint k = 3 leg + j.
+    pub counts: [i32; JOINTS],
+    /// The body pose X, Y, Z, yaw, pitch, roll of the simulated robot at the latch.
+    pub body: [f64; 6],
+    /// Simulated time at the latch (s).
+    pub t: f64,
+}
+
+/// What an emulator run did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EmulatorReport {
+    /// Commands applied (each advanced the model by one period).
+    pub commands: u64,
+    /// Commands that did not decode, by kind.
+    pub rejected: PacketErrorCounts,
+    /// Duplicated or reordered commands ignored.
+    pub ignored: u64,
+    /// Datagrams sent by the six slaves (faults included).
+    pub sent: u64,
+    pub faults: FaultCounts,
+    /// Whether the threads ran with a real-time priority.
+    pub realtime: bool,
+    /// Wall time the model took per period (s): above the period minus the replies' timing, the
+    /// emulator cannot keep up in real time.
+    pub step_time: Percentiles,
+    /// The applied commands in order, with `history`.
+    pub history: Vec<EmulatedPeriod>,
+    /// Body pose of the simulated robot at the end (X, Y, Z, yaw, pitch, roll).
+    pub body: [f64; 6],
+    /// Simulated time at the end (s).
+    pub t: f64,
+    /// Why the emulator stopped early: the model failed, or a socket error.
+    pub error: Option<String>,
+}
+
+/// Six slaves running on their threads.
+pub struct Emulator {
+    stop: Arc<AtomicBool>,
+    model: Option<JoinHandle<EmulatorReport>>,
+    sender: Option<JoinHandle<Result<u64, String>>>,
+    command_address: SocketAddr,
+}
+
+impl Emulator {
+    /// Settles the scenario's robot, binds the command socket (the configuration's broadcast
+    /// address and port; port 0 picks a free one, see [`Self::command_address`]) and the six
+    /// slave sockets, and starts answering.
+    pub fn start(s: &Scenario, config: &LinkConfig, options: EmulatorOptions) -> Result<Emulator, LinkError> {
+        options.faults.validate().map_err(LinkError::Emulator)?;
+        let robot = settled_robot(s)?;
+        let socket_error = |what, address: String| move |source| LinkError::Socket { what, address, source };
+        let commands = UdpSocket::bind(config.broadcast).map_err(socket_error("cannot listen for the commands on", config.broadcast.to_string()))?;
+        commands.set_read_timeout(Some(STOP_POLL)).map_err(socket_error("cannot set a timeout on", config.broadcast.to_string()))?;
+        let command_address = commands.local_addr().map_err(socket_error("cannot read the address of", config.broadcast.to_string()))?;
+        let mut slaves = Vec::with_capacity(LEG_COUNT);
+        for (leg, a) in config.slaves.iter().enumerate() {
+            let what = if leg == 0 { "cannot open the slave socket" } else { "cannot open a slave socket" };
+            slaves.push(UdpSocket::bind(a).map_err(socket_error(what, a.to_string()))?);
+        }
+        let stop = Arc::new(AtomicBool::new(false));
+        let (jobs, queue) = mpsc::channel::<Job>();
+        let timing = config.timing;
+        let stop_sender = stop.clone();
+        let sender = std::thread::Builder::new()
+            .name("hexadyn-slaves".into())
+            .spawn(move || {
+                realtime_thread(timing.realtime_priority);
+                send_loop(&slaves, &queue, &stop_sender)
+            })
+            .map_err(|e| LinkError::Emulator(format!("cannot start the sender thread: {e}")))?;
+        let stop_model = stop.clone();
+        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: robot.robot.model.motors[k].n });
+        let model = std::thread::Builder::new()
+            .name("hexadyn-emulator".into())
+            .spawn(move || {
+                // Below the sender: a long model period must not delay the packets.
+                let realtime = realtime_thread(timing.realtime_priority.map(|p| p.saturating_sub(1).max(1)));
+                let mut e = Slaves { robot, encoders, faults: FaultInjector::new(options.faults.clone()), report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new() };
+                e.serve(&commands, &jobs, &stop_model, options.idle_timeout);
+                e.finish()
+            })
+            .map_err(|e| LinkError::Emulator(format!("cannot start the emulator thread: {e}")))?;
+        Ok(Emulator { stop, model: Some(model), sender: Some(sender), command_address })
+    }
+
+    /// The address the emulator listens on for the commands.
+    pub fn command_address(&self) -> SocketAddr {
+        self.command_address
+    }
+
+    /// Whether the emulator stopped by itself (idle timeout or failure).
+    pub fn is_finished(&self) -> bool {
+        self.model.as_ref().map_or(true, JoinHandle::is_finished)
+    }
+
+    /// Stops the slaves and returns the report.
+    pub fn stop(mut self) -> EmulatorReport {
+        self.shutdown()
+    }
+
+    /// Waits until the emulator stops by itself (idle timeout) or `interrupt` is set.
+    pub fn wait(mut self, interrupt: &AtomicBool) -> EmulatorReport {
+        while !self.is_finished() && !interrupt.load(Ordering::Relaxed) {
+            std::thread::sleep(STOP_POLL);
+        }
+        self.shutdown()
+    }
+
+    fn shutdown(&mut self) -> EmulatorReport {
+        self.stop.store(true, Ordering::Relaxed);
+        let mut report = match self.model.take().map(JoinHandle::join) {
+            Some(Ok(r)) => r,
+            _ => EmulatorReport { error: Some("the emulator thread panicked".into()), ..Default::default() },
+        };
+        match self.sender.take().map(JoinHandle::join) {
+            Some(Ok(Ok(sent))) => report.sent = sent,
+            Some(Ok(Err(e))) => report.error = report.error.or(Some(e)),
+            _ => report.error = report.error.or(Some("the sender thread panicked".into())),
+        }
+        report
+    }
+}
+
+impl Drop for Emulator {
+    fn drop(&mut self) {
+        if self.model.is_some() {
+            self.shutdown();
+        }
+    }
+}
+
+/// A packet due at an instant.
+struct Job {
+    due: Instant,
+    leg: usize,
+    to: SocketAddr,
+    bytes: Vec<u8>,
+}
+
+/// The model side: commands in, latched packets out, one model period per command.
+struct Slaves {
+    robot: SimulatedRobot,
+    encoders: [Encoder; JOINTS],
+    faults: FaultInjector,
+    report: EmulatorReport,
+    last_seq: Option<u16>,
+    timing: super::config::Timing,
+    history: bool,
+    /// Wall time of each model period (s).
+    step_times: Vec<f64>,
+}
+
+impl Slaves {
+    fn serve(&mut self, socket: &UdpSocket, jobs: &Sender<Job>, stop: &AtomicBool, idle_timeout: Option<Duration>) {
+        let mut buf = [0u8; 2048];
+        let mut last_command: Option<Instant> = None;
+        while !stop.load(Ordering::Relaxed) {
+            let (n, from) = match socket.recv_from(&mut buf) {
+                Ok(r) => r,
+                Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted) => {
+                    if let (Some(limit), Some(at)) = (idle_timeout, last_command) {
+                        if at.elapsed() >= limit {
+                            return;
+                        }
+                    }
+                    continue;
+                }
+                Err(e) => {
+                    self.report.error = Some(format!("receiving the commands: {e}"));
+                    return;
+                }
+            };
+            let received = Instant::now();
+            let command = match MotorCommands::decode(&buf[..n]) {
+                Ok(c) => c,
+                Err(e) => {
+                    self.report.rejected.count(&e);
+                    continue;
+                }
+            };
+            if let Some(last) = self.last_seq {
+                let d = seq_distance(command.seq, last);
+                if (-REORDER_WINDOW..=0).contains(&d) {
+                    self.report.ignored += 1;
+                    continue;
+                }
+            }
+            last_command = Some(received);
+            if let Err(e) = self.apply(&command, received, from, jobs) {
+                self.report.error = Some(e);
+                return;
+            }
+        }
+    }
+
+    /// Latches and schedules the six packets, then advances the model with the command.
+    fn apply(&mut self, command: &MotorCommands, received: Instant, to: SocketAddr, jobs: &Sender<Job>) -> Result<(), String> {
+        self.last_seq = Some(command.seq);
+        let state = self.robot.state();
+        let q = state.q.as_slice();
+        let counts: [i64; JOINTS] = std::array::from_fn(|k| self.encoders[k].counts(q[6 + k]));
+        let currents = self.robot.robot.outputs.current;
+        let supply = self.robot.robot.model.options.supply_voltage;
+        let n = self.report.commands;
+        for leg in 0..LEG_COUNT {
+            let j = 3 * leg;
+            let packet = SlaveReply::measured(leg, command.seq, [counts[j], counts[j + 1], counts[j + 2]], [currents[j], currents[j + 1], currents[j + 2]], supply).encode();
+            for Outgoing { leg, delay, bytes } in self.faults.apply(leg, n, self.timing.reply_delay(leg), &packet) {
+                // The sender outlives this thread unless it failed; then packets are moot.
+                let _ = jobs.send(Job { due: received + delay, leg, to, bytes });
+            }
+        }
+        if self.history {
+            let body = std::array::from_fn(|i| q[i]);
+            let counts = counts.map(|c| c.clamp(i64::from(super::protocol::COUNT_MIN), i64::from(super::protocol::COUNT_MAX)) as i32);
+            self.report.history.push(EmulatedPeriod { seq: command.seq, duties: command.duties, counts, body, t: state.t });
+        }
+        let voltages = command.duties.map(|d| d.voltage(supply));
+        self.robot.actuate(&Command { voltages, references: [0.0; JOINTS] });
+        self.report.commands += 1;
+        let stepping = Instant::now();
+        let stepped = self.robot.wait_period();
+        self.step_times.push(stepping.elapsed().as_secs_f64());
+        stepped.map_err(|e| format!("the simulated robot failed at t = {:.3} s: {e}", self.robot.state().t))
+    }
+
+    fn finish(mut self) -> EmulatorReport {
+        let s = self.robot.state();
+        self.report.body = std::array::from_fn(|i| s.q[i]);
+        self.report.t = s.t;
+        self.report.faults = self.faults.counts;
+        self.report.step_time = Percentiles::of(&self.step_times);
+        self.report
+    }
+}
+
+/// Sends each packet at its due time until told to stop; returns the datagrams sent. No spin:
+/// the boards themselves answer within ±300 µs (Δt_d, Section 2.3.2).
+fn send_loop(slaves: &[UdpSocket], queue: &Receiver<Job>, stop: &AtomicBool) -> Result<u64, String> {
+    let mut pending: BinaryHeap<Reverse<(Instant, u64)>> = BinaryHeap::new();
+    let mut jobs = std::collections::HashMap::new();
+    let (mut next_id, mut sent) = (0u64, 0u64);
+    loop {
+        // Wait for the next due packet, taking new ones as they come.
+        let wake = pending.peek().map(|Reverse((due, _))| *due);
+        let incoming = match wake {
+            Some(due) => {
+                match due.checked_duration_since(Instant::now()) {
+                    Some(wait) if !wait.is_zero() => queue.recv_timeout(wait),
+                    _ => Err(RecvTimeoutError::Timeout),
+                }
+            }
+            None => queue.recv_timeout(STOP_POLL),
+        };
+        match incoming {
+            Ok(job) => {
+                pending.push(Reverse((job.due, next_id)));
+                jobs.insert(next_id, job);
+                next_id += 1;
+                continue;
+            }
+            Err(RecvTimeoutError::Disconnected) if pending.is_empty() => return Ok(sent),
+            Err(_) if wake.is_none() => {
+                if stop.load(Ordering::Relaxed) {
+                    return Ok(sent);
+                }
+                continue;
+            }
+            Err(_) => {}
+        }
+        let Some(Reverse((due, id))) = pending.pop() else { continue };
+        sleep_until(due, Duration::ZERO);
+        let job = jobs.remove(&id).ok_or("a scheduled packet vanished")?;
+        slaves[job.leg].send_to(&job.bytes, job.to).map_err(|e| format!("slave {} could not send to {}: {e}", job.leg, job.to))?;
+        sent += 1;
+    }
+}

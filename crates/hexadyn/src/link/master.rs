@@ -1,0 +1,388 @@
+//! The master side of the link: the deadline loop of Section 2.3.2 (the pseudo-code under
+//! Fig. 2.17). At each deadline of an absolute monotonic clock the master broadcasts the 18
+//! motor commands, then collects the six slave packets; the period is complete when the last
+//! one arrives, and the controller runs at once (in [`super::UdpPlant`]). Waiting is precise
+//! ([`super::clock::wait_readable`]): `ppoll` up to the deadline minus a spin margin, then a
+//! spin.
+//!
+//! Freshness: a slave packet is used only if it comes from the configured address of its leg,
+//! decodes (size, CRC, version, ranges), names that leg and echoes the sequence number of the
+//! current period, for the first time. Everything else is counted, logged and dropped: a stale
+//! or out-of-order packet is never taken as fresh.
+//!
+//! Safety: a slave silent for `safety.missing_periods` periods in a row (3 by default), a
+//! controller overrun (its command not ready at the deadline) or an interrupt broadcasts 0 V
+//! to every motor and stops the run with a [`SafetyStop`]. Dropping a master that has not
+//! stopped does the same.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::os::fd::AsRawFd;
+use std::time::{Duration, Instant};
+
+use super::clock::{wait_readable, Wake};
+use super::config::LinkConfig;
+use super::protocol::{seq_distance, Duty, MotorCommands, PacketErrorCounts, SlaveReply, COMMAND_SIZE};
+use super::LinkError;
+use crate::hexapod::{JOINTS, LEG_COUNT};
+
+/// How many link events a run keeps (the counters go on counting).
+const MAX_EVENTS: usize = 200;
+/// How many times the stop command (0 V) is sent, back to back, with the same sequence number.
+const STOP_REPEATS: usize = 3;
+
+/// Why the master stopped the robot.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StopReason {
+    /// These slaves' packets were missing for `periods` periods in a row.
+    MissingReplies { legs: Vec<usize>, periods: u32 },
+    /// The controller's command was not ready at its deadline (late by `late_s`).
+    Overrun { late_s: f64 },
+    /// The user asked to stop.
+    Interrupted,
+}
+
+/// A safety stop: every motor was put to 0 V at `period`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SafetyStop {
+    pub period: u64,
+    pub reason: StopReason,
+}
+
+impl std::fmt::Display for SafetyStop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.reason {
+            StopReason::MissingReplies { legs, periods } => write!(f, "safety stop at period {}: no packet from the slave(s) of leg(s) {legs:?} for {periods} periods; every motor set to 0 V", self.period),
+            StopReason::Overrun { late_s } => write!(f, "safety stop at period {}: controller overrun, its command was {:.3} ms late for the deadline; every motor set to 0 V", self.period, late_s * 1e3),
+            StopReason::Interrupted => write!(f, "stopped at period {} on request; every motor set to 0 V", self.period),
+        }
+    }
+}
+
+/// A datagram the master dropped, with the period it came in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkEvent {
+    pub period: u64,
+    pub message: String,
+}
+
+/// What the master counted and measured.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LinkStats {
+    /// Broadcasts at a deadline (the stop commands excluded).
+    pub broadcasts: u64,
+    pub complete_periods: u64,
+    /// Periods at whose end a slave packet was missing (the controller did not run).
+    pub missed_periods: u64,
+    /// Lateness of each broadcast against its deadline (s).
+    pub lateness: Vec<f64>,
+    /// For each complete period, when the last packet arrived after the broadcast (s).
+    pub last_reply: Vec<f64>,
+    /// Packets that did not decode, by kind.
+    pub rejected: PacketErrorCounts,
+    /// Packets whose leg field is not the leg of their source address.
+    pub wrong_leg: u64,
+    /// Packets of an earlier period (late, reordered).
+    pub stale: u64,
+    /// Packets numbered after the current period.
+    pub future: u64,
+    /// Second packets of a slave in one period.
+    pub duplicates: u64,
+    /// Datagrams from an address that is no configured slave.
+    pub unknown_source: u64,
+    /// Whether the master thread ran with a real-time priority.
+    pub realtime: bool,
+    /// Events beyond [`MAX_EVENTS`] that were counted but not kept.
+    pub events_dropped: u64,
+}
+
+impl LinkStats {
+    /// Datagrams that never reached the controller.
+    pub fn dropped(&self) -> u64 {
+        self.rejected.total() + self.wrong_leg + self.stale + self.future + self.duplicates + self.unknown_source
+    }
+}
+
+/// The master's socket, clock and per-period bookkeeping.
+pub struct Master {
+    socket: UdpSocket,
+    config: LinkConfig,
+    /// Index of the current period (the last broadcast at a deadline).
+    period: u64,
+    started: bool,
+    next_deadline: Instant,
+    broadcast_at: Instant,
+    replies: [Option<SlaveReply>; LEG_COUNT],
+    arrivals: [Duration; LEG_COUNT],
+    missing: [u32; LEG_COUNT],
+    stopped: bool,
+    pub stats: LinkStats,
+    pub events: Vec<LinkEvent>,
+}
+
+impl Master {
+    /// Binds the master socket (broadcast allowed); the clock starts with [`Self::start_clock`].
+    pub fn bind(config: &LinkConfig) -> Result<Master, LinkError> {
+        let socket_error = |source| LinkError::Socket { what: "cannot open the master socket", address: config.master.to_string(), source };
+        let socket = UdpSocket::bind(config.master).map_err(socket_error)?;
+        socket.set_broadcast(true).map_err(socket_error)?;
+        socket.set_nonblocking(true).map_err(socket_error)?;
+        let now = Instant::now();
+        Ok(Master {
+            socket,
+            config: config.clone(),
+            period: 0,
+            started: false,
+            next_deadline: now,
+            broadcast_at: now,
+            replies: [None; LEG_COUNT],
+            arrivals: [Duration::ZERO; LEG_COUNT],
+            missing: [0; LEG_COUNT],
+            stopped: false,
+            stats: LinkStats::default(),
+            events: Vec::new(),
+        })
+    }
+
+    pub fn local_addr(&self) -> std::io::Result<SocketAddr> {
+        self.socket.local_addr()
+    }
+
+    pub fn config(&self) -> &LinkConfig {
+        &self.config
+    }
+
+    /// The first deadline is one period from now.
+    pub fn start_clock(&mut self) {
+        self.next_deadline = Instant::now() + self.config.timing.period;
+    }
+
+    /// Index of the current period.
+    pub fn period(&self) -> u64 {
+        self.period
+    }
+
+    /// When the next broadcast is due.
+    pub fn next_deadline(&self) -> Instant {
+        self.next_deadline
+    }
+
+    /// Per slave, when its packet of the current period arrived after the broadcast.
+    pub fn arrivals(&self) -> [Duration; LEG_COUNT] {
+        self.arrivals
+    }
+
+    fn event(&mut self, message: String) {
+        if self.events.len() < MAX_EVENTS {
+            self.events.push(LinkEvent { period: self.period, message });
+        } else {
+            self.stats.events_dropped += 1;
+        }
+    }
+
+    /// One period: waits for the deadline, broadcasts `duties`, collects the slave packets.
+    /// Returns them when all six came fresh before the next deadline, `None` when some are
+    /// missing; stops the robot when a slave has been missing too long.
+    pub fn run_period(&mut self, duties: &[Duty; JOINTS]) -> Result<Option<[SlaveReply; LEG_COUNT]>, LinkError> {
+        self.wait(self.next_deadline)?;
+        self.broadcast(duties)?;
+        self.collect()?;
+        let mut silent = Vec::new();
+        for leg in 0..LEG_COUNT {
+            if self.replies[leg].is_some() {
+                self.missing[leg] = 0;
+            } else {
+                self.missing[leg] += 1;
+                if self.missing[leg] >= self.config.safety.missing_periods {
+                    silent.push(leg);
+                }
+            }
+        }
+        if !silent.is_empty() {
+            let periods = self.config.safety.missing_periods;
+            return Err(self.safety_stop(StopReason::MissingReplies { legs: silent, periods }));
+        }
+        match self.replies {
+            [Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)] => {
+                self.stats.complete_periods += 1;
+                let last = self.arrivals.iter().max().copied().unwrap_or_default();
+                self.stats.last_reply.push(last.as_secs_f64());
+                Ok(Some([a, b, c, d, e, f]))
+            }
+            _ => {
+                self.stats.missed_periods += 1;
+                let legs: Vec<usize> = (0..LEG_COUNT).filter(|&l| self.replies[l].is_none()).collect();
+                self.event(format!("period missed: no fresh packet from leg(s) {legs:?} before the deadline"));
+                Ok(None)
+            }
+        }
+    }
+
+    /// The start: broadcasts 0 V every period until the six slaves answer in one period, for
+    /// at most the configured connect timeout (a missing slave is no safety stop yet).
+    pub fn connect(&mut self) -> Result<[SlaveReply; LEG_COUNT], LinkError> {
+        let give_up = Instant::now() + self.config.safety.connect_timeout;
+        loop {
+            self.wait(self.next_deadline)?;
+            self.broadcast(&[Duty::ZERO; JOINTS])?;
+            self.collect()?;
+            if let [Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)] = self.replies {
+                self.stats.complete_periods += 1;
+                return Ok([a, b, c, d, e, f]);
+            }
+            if Instant::now() >= give_up {
+                self.stop();
+                let legs = (0..LEG_COUNT).filter(|&l| self.replies[l].is_none()).collect();
+                return Err(LinkError::NoAnswer { legs, timeout_s: self.config.safety.connect_timeout.as_secs_f64(), broadcast: self.config.broadcast.to_string() });
+            }
+        }
+    }
+
+    /// Stops the robot if the next deadline has passed (the controller overran); call when the
+    /// controller's command is ready.
+    pub fn check_overrun(&mut self) -> Result<(), LinkError> {
+        let now = Instant::now();
+        if self.started && now > self.next_deadline + self.config.safety.overrun_tolerance {
+            let late_s = (now - self.next_deadline).as_secs_f64();
+            return Err(self.safety_stop(StopReason::Overrun { late_s }));
+        }
+        Ok(())
+    }
+
+    /// Broadcasts 0 V to every motor at once and returns the stop as an error.
+    pub fn safety_stop(&mut self, reason: StopReason) -> LinkError {
+        self.stop();
+        let stop = SafetyStop { period: self.period, reason };
+        self.event(stop.to_string());
+        LinkError::Stopped(stop)
+    }
+
+    /// Puts every motor to 0 V now (the zero command sent three times, one sequence number).
+    pub fn stop(&mut self) {
+        if self.stopped {
+            return;
+        }
+        self.stopped = true;
+        let seq = if self.started { self.period.wrapping_add(1) as u16 } else { 0 };
+        let bytes = MotorCommands::zero(seq).encode();
+        for _ in 0..STOP_REPEATS {
+            if let Err(e) = self.socket.send_to(&bytes, self.config.broadcast) {
+                self.event(format!("the stop command could not be sent: {e}"));
+            }
+        }
+    }
+
+    /// Reads and counts what still arrives during `duration` (after a stop: the slaves' late
+    /// packets and their answers to the stop command), so that the counters see every packet.
+    pub fn linger(&mut self, duration: Duration) {
+        let until = Instant::now() + duration;
+        while let Ok(Wake::Readable) = self.poll(until) {
+            self.drain();
+        }
+    }
+
+    pub fn is_stopped(&self) -> bool {
+        self.stopped
+    }
+
+    /// Waits until `deadline`, dropping (and counting) whatever arrives meanwhile.
+    fn wait(&mut self, deadline: Instant) -> Result<(), LinkError> {
+        while self.poll(deadline)? == Wake::Readable {
+            self.drain();
+        }
+        Ok(())
+    }
+
+    fn poll(&self, deadline: Instant) -> Result<Wake, LinkError> {
+        wait_readable(self.socket.as_raw_fd(), deadline, self.config.timing.spin).map_err(|source| LinkError::Socket { what: "cannot poll the master socket", address: self.config.master.to_string(), source })
+    }
+
+    fn broadcast(&mut self, duties: &[Duty; JOINTS]) -> Result<(), LinkError> {
+        if self.started {
+            self.period += 1;
+        }
+        let bytes: [u8; COMMAND_SIZE] = MotorCommands { seq: self.period as u16, duties: *duties }.encode();
+        let now = Instant::now();
+        self.socket.send_to(&bytes, self.config.broadcast).map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
+        let deadline = self.next_deadline;
+        self.stats.lateness.push(now.saturating_duration_since(deadline).as_secs_f64());
+        self.stats.broadcasts += 1;
+        self.started = true;
+        self.broadcast_at = now;
+        self.next_deadline = deadline + self.config.timing.period;
+        self.replies = [None; LEG_COUNT];
+        self.arrivals = [Duration::ZERO; LEG_COUNT];
+        Ok(())
+    }
+
+    /// Collects packets until the six of this period are in or the next deadline comes.
+    fn collect(&mut self) -> Result<(), LinkError> {
+        while self.replies.iter().any(Option::is_none) {
+            if self.poll(self.next_deadline)? == Wake::Deadline {
+                break;
+            }
+            self.drain();
+        }
+        Ok(())
+    }
+
+    /// Reads every datagram waiting on the socket.
+    fn drain(&mut self) {
+        let mut buf = [0u8; 2048];
+        loop {
+            match self.socket.recv_from(&mut buf) {
+                Ok((n, from)) => {
+                    let at = Instant::now();
+                    self.receive(&buf[..n], from, at);
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => {
+                    // ICMP errors (a slave's port unreachable) surface here on Linux.
+                    self.event(format!("receive error: {e}"));
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Classifies one datagram; only a fresh packet of this period is kept.
+    fn receive(&mut self, bytes: &[u8], from: SocketAddr, at: Instant) {
+        let Some(leg) = self.config.leg_of(from) else {
+            self.stats.unknown_source += 1;
+            self.event(format!("{} bytes from {from}, no configured slave: dropped", bytes.len()));
+            return;
+        };
+        let reply = match SlaveReply::decode(bytes) {
+            Ok(r) => r,
+            Err(e) => {
+                self.stats.rejected.count(&e);
+                self.event(format!("packet of leg {leg} rejected: {e}"));
+                return;
+            }
+        };
+        if usize::from(reply.leg) != leg {
+            self.stats.wrong_leg += 1;
+            self.event(format!("packet from leg {leg}'s address names leg {}: dropped", reply.leg));
+            return;
+        }
+        let d = seq_distance(reply.seq, self.period as u16);
+        if !self.started || d < 0 {
+            self.stats.stale += 1;
+            self.event(format!("stale packet of leg {leg} (sequence {}, {} period(s) old): dropped", reply.seq, -d));
+        } else if d > 0 {
+            self.stats.future += 1;
+            self.event(format!("packet of leg {leg} numbered {} period(s) ahead: dropped", d));
+        } else if self.replies[leg].is_some() {
+            self.stats.duplicates += 1;
+        } else {
+            self.replies[leg] = Some(reply);
+            self.arrivals[leg] = at.saturating_duration_since(self.broadcast_at);
+        }
+    }
+}
+
+impl Drop for Master {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}

@@ -1,0 +1,54 @@
+//! The real-time link to the robot (thesis Section 2.3.2, Figs. 2.17-2.22): the master PC
+//! broadcasts the 18 motor commands to the six slave boards over UDP every 10 ms and collects
+//! their sensor packets; the same controller that drives the simulated robot drives the real
+//! one (architecture principle 3).
+//!
+//! - [`protocol`]: the 36-byte command and 20-byte slave packets (layout, scaling, CRC);
+//! - [`config`]: the link configuration file (addresses, period, Fig. 2.21 timing, safety);
+//! - [`clock`]: precise waits on the monotonic clock for the deadline loop;
+//! - [`master`]: the deadline loop, packet freshness and the safety stops;
+//! - [`UdpPlant`]: the robot behind the link as a [`crate::control::Plant`];
+//! - [`emulator`]: six slaves answering like the boards, backed by the simulated robot, with
+//!   injectable faults ([`faults`]);
+//! - [`run`]: a scenario's controller driving the robot through the link, recorded like a
+//!   simulation.
+//!
+//! The link sits above [`crate::scenario`]: it runs a scenario's controller, and the emulator
+//! the scenario's simulated robot.
+
+pub mod clock;
+pub mod config;
+pub mod emulator;
+pub mod faults;
+pub mod master;
+pub mod protocol;
+pub mod run;
+mod udp_plant;
+
+pub use config::{ConfigError, LinkConfig, Safety, Timing};
+pub use master::{SafetyStop, StopReason};
+pub use udp_plant::{MissedPeriod, UdpPlant};
+
+use crate::scenario::ScenarioError;
+
+/// What can go wrong on the link.
+#[derive(Debug, thiserror::Error)]
+pub enum LinkError {
+    #[error("{0}")]
+    Config(#[from] ConfigError),
+    #[error("{0}")]
+    Scenario(#[from] ScenarioError),
+    #[error("{what} {address}: {source}")]
+    Socket { what: &'static str, address: String, source: std::io::Error },
+    /// The scenario and the link configuration do not fit together.
+    #[error("{0}")]
+    Mismatch(String),
+    #[error("no answer from the slave(s) of leg(s) {legs:?} within {timeout_s} s of commands broadcast to {broadcast}: check that the boards (or `hexadyn robot emulate`) run with this link configuration")]
+    NoAnswer { legs: Vec<usize>, timeout_s: f64, broadcast: String },
+    /// The master stopped the robot (every motor at 0 V).
+    #[error("{0}")]
+    Stopped(SafetyStop),
+    /// The emulator's simulated robot failed.
+    #[error("the emulated robot failed: {0}")]
+    Emulator(String),
+}

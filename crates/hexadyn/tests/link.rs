@@ -1,0 +1,163 @@
+//! The robot link over the loopback interface (thesis Section 2.3.2): the master driving a
+//! scenario's controller against the emulated slaves, with and without faults. Every test
+//! uses 127.0.0.0/8 only (the broadcast to 127.255.255.255) and ends by itself. Nothing here
+//! asserts on time: the timing figures are in the `link` benchmark. The machine running the
+//! tests is shared, so its scheduling hiccups can make a packet late now and then: except in
+//! the test of the 3-period safety stop itself, the master tolerates 10 missing periods in a
+//! row, and every test lets a command be up to 5 ms late before calling it an overrun, so that
+//! only the faults under test decide the outcome.
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use hexadyn::control::Encoder;
+use hexadyn::hexapod::{Joint, JOINTS};
+use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
+use hexadyn::link::faults::Faults;
+use hexadyn::link::run::{run_robot, RobotRun};
+use hexadyn::link::{LinkConfig, LinkError, StopReason};
+use hexadyn::scenario::{run_scenario, Override, Scenario};
+
+/// Missing periods tolerated by the tests that are not about the safety stop.
+const TOLERANT: u32 = 10;
+
+fn scenario(name: &str, duration_s: f64) -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios").join(format!("{name}.toml"));
+    Scenario::from_file_with(path, &[Override { field: "scenario.duration_s".into(), value: toml::Value::Float(duration_s) }]).expect("shipped scenario")
+}
+
+/// Runs `s` through the master against the emulator on loopback; the master stops the robot
+/// after `missing_periods` periods without a packet of a slave.
+fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRun, LinkError>, EmulatorReport) {
+    let mut config = LinkConfig::loopback(0);
+    config.safety.missing_periods = missing_periods;
+    config.safety.overrun_tolerance = Duration::from_millis(5);
+    // Real-time threads where permitted: the machine running the tests is shared.
+    config.timing.realtime_priority = Some(40);
+    let options = EmulatorOptions { faults, idle_timeout: Some(Duration::from_secs(5)), history: true };
+    let emulator = Emulator::start(s, &config, options).expect("emulator");
+    config.broadcast.set_port(emulator.command_address().port());
+    let run = run_robot(s, &config, |_| ControlFlow::Continue(()));
+    let report = emulator.stop();
+    if let Ok(r) = &run {
+        println!("{}: {} periods, {} missed, real-time {}, emulator model period p99 {:.2} ms", s.name, r.stats.broadcasts, r.stats.missed_periods, r.stats.realtime, report.step_time.p99 * 1e3);
+    }
+    (run, report)
+}
+
+/// The master's recorded encoder positions are, period by period, exactly the counts the
+/// emulator latched for that sequence number: no corrupted, stale or foreign packet reached
+/// the controller.
+fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) {
+    let encoders: [Encoder; JOINTS] = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: s.robot.reduction(Joint::ALL[k % 3]) });
+    let periods = run.series.values("period").expect("period column");
+    for (row, &p) in periods.iter().enumerate() {
+        if run.series.values("last_reply").expect("last_reply")[row].is_nan() {
+            continue; // a missed period: nothing measured
+        }
+        let latched = report.history.iter().find(|h| u64::from(h.seq) == p as u64).unwrap_or_else(|| panic!("period {p} was never applied by the emulator"));
+        for (k, enc) in encoders.iter().enumerate() {
+            let name = format!("{}[{}]", Joint::ALL[k % 3].symbol(), k / 3);
+            let seen = run.series.values(&name).expect("position column")[row];
+            assert_eq!(seen, f64::from(latched.counts[k]) * enc.resolution(), "row {row} (period {p}), {name}");
+        }
+    }
+}
+
+#[test]
+fn walk_through_master_and_emulator_ends_within_1_mm_of_the_simulation() {
+    let s = scenario("validation_tripod_1_5cm", 60.0);
+    let direct = run_scenario(&s, |_| {}).expect("simulation");
+    let (run, report) = linked(&s, Faults::default(), TOLERANT);
+    let run = run.expect("linked walk");
+    assert!(run.stop.is_none(), "{:?}", run.stop);
+    assert_eq!(report.error, None);
+    let x = direct.series.values("X").expect("X");
+    let y = direct.series.values("Y").expect("Y");
+    let (xe, ye) = (x[x.len() - 1], y[y.len() - 1]);
+    let [xl, yl, ..] = report.body;
+    let d = (xl - xe).hypot(yl - ye);
+    println!("walk of {:.3} m: master + emulator ends {:.3} mm from the simulation ({} periods, {} missed)", xe, d * 1e3, run.stats.broadcasts, run.stats.missed_periods);
+    assert!(xe > 0.8, "the simulated walk covers 0.9 m, got {xe}");
+    assert!(d < 1e-3, "{:.3} mm apart", d * 1e3);
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+/// 5 % of the slave packets lost at random, independently. (With the default limit of 3
+/// missing periods some slave would lose 3 in a row about every 13 s and stop the robot, by
+/// design; `Faults::max_consecutive` caps such bursts when the default limit is kept.)
+#[test]
+fn five_percent_loss_the_walk_completes() {
+    let s = scenario("validation_tripod_1_5cm", 24.0);
+    let faults = Faults { loss: 0.05, seed: 5, ..Default::default() };
+    let (run, report) = linked(&s, faults, TOLERANT);
+    let run = run.expect("walk with loss");
+    assert!(run.stop.is_none(), "{:?}", run.stop);
+    assert!(report.faults.lost > 400, "{:?}", report.faults);
+    // Every lost packet made its period miss (the controller waited for the next one).
+    assert!(run.stats.missed_periods >= report.faults.lost / 6, "{} missed, {:?}", run.stats.missed_periods, report.faults);
+    let t = run.series.values("t").expect("t");
+    assert!(t[t.len() - 1] >= 24.0 - 1e-9);
+    assert!(report.body[0] > 0.2, "walked {} m", report.body[0]);
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+#[test]
+fn a_silent_slave_stops_the_robot_within_3_periods_at_0_v() {
+    let s = scenario("validation_tripod_1_5cm", 10.0);
+    let silent_from = 150;
+    let faults = Faults { silent_slave: Some((3, silent_from)), ..Default::default() };
+    let (run, report) = linked(&s, faults, 3);
+    let run = run.expect("a safety stop is a result, not an error");
+    let stop = run.stop.clone().expect("safety stop");
+    assert_eq!(stop.reason, StopReason::MissingReplies { legs: vec![3], periods: 3 });
+    let last = report.history.last().expect("commands");
+    // The last command the robot applied is the stop: every motor at 0 V, three periods after
+    // the first unanswered command; nothing came after it.
+    assert!(last.duties.iter().all(|d| d.get() == 0), "{:?}", last.duties);
+    assert_eq!(u64::from(last.seq), silent_from + 3);
+    assert_eq!(report.commands, silent_from + 4);
+    assert!(report.history[..report.history.len() - 1].iter().rev().take(3).any(|h| h.duties.iter().any(|d| d.get() != 0)), "it was walking");
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+#[test]
+fn corrupted_and_wrong_size_packets_are_counted_and_never_reach_the_controller() {
+    let s = scenario("validation_tripod_1_5cm", 6.0);
+    let faults = Faults { corrupt: 0.05, wrong_size: 0.03, seed: 9, ..Default::default() };
+    let (run, report) = linked(&s, faults, TOLERANT);
+    let run = run.expect("walk with corrupted packets");
+    assert!(run.stop.is_none(), "{:?}", run.stop);
+    assert!(report.faults.corrupted > 50 && report.faults.wrong_size > 30, "{:?}", report.faults);
+    assert_eq!(run.stats.rejected.checksum, report.faults.corrupted);
+    assert_eq!(run.stats.rejected.size, report.faults.wrong_size);
+    assert_eq!(run.stats.rejected.version + run.stats.rejected.range + run.stats.wrong_leg, 0);
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+#[test]
+fn late_reordered_and_duplicated_packets_are_never_used_as_fresh() {
+    let s = scenario("validation_tripod_1_5cm", 6.0);
+    let faults = Faults { reorder: 0.05, duplicate: 0.05, jitter: Duration::from_micros(1000), seed: 11, ..Default::default() };
+    let (run, report) = linked(&s, faults, TOLERANT);
+    let run = run.expect("walk with reordering");
+    assert!(run.stop.is_none(), "{:?}", run.stop);
+    assert!(report.faults.reordered > 50 && report.faults.duplicated > 50, "{:?}", report.faults);
+    // A held-back packet arrives a period late: stale.
+    assert!(run.stats.stale >= report.faults.reordered - 6, "{} stale, {:?}", run.stats.stale, report.faults);
+    assert!(run.stats.duplicates > 0);
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+#[test]
+fn no_slave_no_run() {
+    let s = scenario("stand_six_legs", 1.0);
+    let mut config = LinkConfig::loopback(47_999);
+    config.safety.connect_timeout = Duration::from_millis(100);
+    let e = run_robot(&s, &config, |_| ControlFlow::Continue(())).expect_err("nobody answers");
+    assert!(matches!(&e, LinkError::NoAnswer { legs, .. } if legs.len() == 6), "{e}");
+    config.timing.period = Duration::from_millis(20);
+    let e = run_robot(&s, &config, |_| ControlFlow::Continue(())).expect_err("wrong period");
+    assert!(e.to_string().contains("timing.period_s"), "{e}");
+}

@@ -1,0 +1,25 @@
+"""The robot link of Section 2.3.2: the master/slave packets (:mod:`hexadyn.link.packets`, a
+mirror of the engine's), and ``hexadyn robot run`` / ``hexadyn robot emulate``
+(:mod:`hexadyn.link.cli`), which run a scenario's controller on the robot, or on the slave
+emulator backed by the simulated robot."""
+
+from __future__ import annotations
+
+import errno
+import os
+from pathlib import Path
+
+#: The shipped link configuration on the loopback interface (``--link loopback``).
+LOOPBACK = Path(__file__).resolve().parent / "loopback.toml"
+
+__all__ = ["LOOPBACK", "resolve_link"]
+
+
+def resolve_link(link: str | os.PathLike) -> Path:
+    """The link configuration file for a path, or ``"loopback"`` for :data:`LOOPBACK`."""
+    path = Path(link)
+    if path.is_file():
+        return path
+    if os.fspath(link) == "loopback":
+        return LOOPBACK
+    raise FileNotFoundError(errno.ENOENT, "no such link configuration file (or \"loopback\" for the shipped one)", os.fspath(link))
