@@ -15,7 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from hexadyn.results import FORMAT, METADATA_FILE, TIMESERIES_FILE
+#: The results folder layout documented in the README (written by hexadyn.results).
+TIMESERIES_FILE = "timeseries.parquet"
+METADATA_FILE = "metadata.json"
+FORMAT = "hexadyn-results"
 
 #: Generalized coordinates in the engine's order (Eq. 3.51): body pose, then q_r q_v q_h per leg.
 LEGS = 6
