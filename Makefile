@@ -17,7 +17,7 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup run test test-rust test-python bench bench-montecarlo lock clean
+.PHONY: help setup chromium run test test-rust test-python bench bench-montecarlo lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
@@ -28,15 +28,17 @@ help:
 	@echo "make lock   re-resolve requirements/lock.txt"
 	@echo "make clean  remove .venv and the Cargo target directory"
 
-setup: $(BUILD_STAMP)
+setup: $(BUILD_STAMP) chromium
+
+# The viewer's browser tests drive Debian's chromium (Playwright cannot download its own here).
+chromium:
+	@command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium; }
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 
 # Pinned dependencies and the editable install (pip runs maturin, which builds _core in release).
-# The viewer's browser tests drive Debian's chromium (Playwright cannot download its own here).
 $(DEPS_STAMP): $(LOCK) pyproject.toml | $(PY)
-	command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium; }
 	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) maturin
 	PATH="$(abspath $(VENV))/bin:$$PATH" \
 	  $(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) --no-build-isolation -e '.[test]'

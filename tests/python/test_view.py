@@ -22,7 +22,7 @@ from click.testing import CliRunner
 from matplotlib.image import imread
 
 from hexadyn import _core, report
-from hexadyn.cli import cli
+from hexadyn.view.command import view
 from hexadyn.view.data import FOOT_COLUMNS, Run, ViewError
 from hexadyn.view.measure import FRAME_COUNTER_JS, HEADLESS_CHROMIUM_ARGS
 
@@ -138,7 +138,8 @@ def test_view_command_serves_on_loopback_and_prints_the_url(walk_folder):
     import sys
     import urllib.request
 
-    process = subprocess.Popen([sys.executable, "-m", "hexadyn.cli", "view", str(walk_folder), "--no-open"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    hexadyn_script = Path(sys.executable).with_name("hexadyn")  # the console script of the install
+    process = subprocess.Popen([str(hexadyn_script), "view", str(walk_folder), "--no-open"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
         line = process.stdout.readline()
         url = re.search(r"http://127\.0\.0\.1:\d+/", line)
@@ -161,7 +162,7 @@ def test_view_rejects_what_is_not_a_results_folder(walk_folder, tmp_path):
     pq.write_table(table.drop(["foot_x[2]"]), broken / "timeseries.parquet")
     with pytest.raises(ViewError, match=r"timeseries\.parquet: missing column foot_x\[2\]"):
         Run(broken)
-    result = CliRunner().invoke(cli, ["view", str(broken), "--no-open"])
+    result = CliRunner().invoke(view, [str(broken), "--no-open"])
     assert result.exit_code == 1 and "missing column foot_x[2]" in result.output
 
 
@@ -248,7 +249,7 @@ def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder,
 
 def test_view_html_export_plays_from_a_static_server_and_a_file_url(walk_folder, live, browser, tmp_path):
     export = tmp_path / "site" / "walk.html"
-    result = CliRunner().invoke(cli, ["view", str(walk_folder), "--html", str(export)])
+    result = CliRunner().invoke(view, [str(walk_folder), "--html", str(export)])
     assert result.exit_code == 0, result.output
     assert export.is_file() and "__VISER_EMBED_DATA__" in export.read_text()
 

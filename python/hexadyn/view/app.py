@@ -29,8 +29,8 @@ SPEEDS = ("0.25", "0.5", "1", "2", "5", "10", "50")
 #: While playing: scene updates per second, and updates per second of the panel (time slider and
 #: read-out) and of the chart cursors, fewer as they cost the browser more than the scene.
 TICK_HZ = 30.0
-PANEL_HZ = 10.0
-CURSOR_HZ = 4.0
+PANEL_HZ = 5.0
+CURSOR_HZ = 2.0
 
 
 class Viewer:

@@ -25,12 +25,17 @@ def view(folder: Path, html_file: Path | None, port: int | None, no_open: bool) 
         import viser  # noqa: F401
     except ImportError as exc:
         raise click.ClickException("hexadyn view needs viser: pip install 'hexadyn[view]'") from exc
-    if html_file is not None:
-        from hexadyn.view.export import export_html
+    from hexadyn.view.data import ViewError
 
-        path = export_html(folder, html_file)
-        click.echo(f"Wrote {path} ({path.stat().st_size / 1e6:.1f} MB): open it in a browser, or serve it from any static web server")
-        return
-    from hexadyn.view.server import serve
+    try:
+        if html_file is not None:
+            from hexadyn.view.export import export_html
 
-    serve(folder, port=port, open_browser=not no_open, echo=click.echo)
+            path = export_html(folder, html_file)
+            click.echo(f"Wrote {path} ({path.stat().st_size / 1e6:.1f} MB): open it in a browser, or serve it from any static web server")
+            return
+        from hexadyn.view.server import serve
+
+        serve(folder, port=port, open_browser=not no_open, echo=click.echo)
+    except ViewError as exc:
+        raise click.ClickException(str(exc)) from exc

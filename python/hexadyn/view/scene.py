@@ -21,8 +21,9 @@ CHASSIS_COLOUR = (120, 130, 145)
 LINK_COLOURS = ((205, 160, 60), (150, 150, 150), (150, 150, 150), (215, 120, 40))
 #: Foot colour per phase code (0 support, 1 takeoff, 2 swing, 3 landing) and without a gait.
 PHASE_COLOURS = {0: (30, 30, 30), 1: (240, 170, 0), 2: (230, 60, 40), 3: (40, 150, 230), -1: (30, 30, 30)}
-PATH_COLOUR = (30, 100, 220)
-REFERENCE_COLOUR = (40, 170, 60)
+PATH_COLOUR = (20, 50, 200)
+GRID_COLOUR = (150, 150, 150)
+REFERENCE_COLOUR = (130, 210, 130)
 FOOTHOLD_COLOUR = (120, 60, 160)
 FORCE_COLOUR = (220, 30, 120)
 
@@ -31,8 +32,12 @@ FORCE_SCALE_M_PER_N = 1.5e-3
 #: Link cross-section (m) and foot sphere radius (m).
 LINK_WIDTH = 0.014
 FOOT_RADIUS = 0.012
+FOOTHOLD_RADIUS = 0.012
 #: Initial camera: offset from the body's start (m), looking at it.
 CAMERA_OFFSET = np.array([-0.9, -1.4, 0.8])
+#: Ground marks: a cross of GRID_CROSS (m) every GRID_STEP (m).
+GRID_STEP = 0.5
+GRID_CROSS = 0.08
 #: Most points drawn for a path (decimated beyond).
 PATH_POINTS = 500
 
@@ -65,6 +70,35 @@ def _prism(polygon: np.ndarray, z0: float, z1: float) -> tuple[np.ndarray, np.nd
         j = (i + 1) % k
         faces += [[cb, j, i], [ct, k + i, k + j], [i, j, k + j], [i, k + j, k + i]]
     return vertices, np.array(faces, dtype=np.uint32)
+
+
+def _ribbons(polylines: list[np.ndarray], width: float, z: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of flat strips `width` wide at height `z` along polylines (K, 2):
+    one quad per segment."""
+    quads = []
+    for points in polylines:
+        a, b = points[:-1], points[1:]
+        d = b - a
+        length = np.linalg.norm(d, axis=1)
+        a, b, d, length = a[length > 0], b[length > 0], d[length > 0], length[length > 0]
+        side = np.column_stack([-d[:, 1], d[:, 0]]) * (width / 2 / length)[:, None]
+        quads.append(np.stack([a + side, a - side, b - side, b + side], axis=1))
+    corners = np.concatenate(quads)
+    vertices = np.column_stack([corners.reshape(-1, 2), np.full(corners.shape[0] * 4, z)]).astype(np.float32)
+    base = 4 * np.arange(corners.shape[0], dtype=np.uint32)[:, None]
+    faces = np.concatenate([base + np.array([0, 1, 2], dtype=np.uint32), base + np.array([0, 2, 3], dtype=np.uint32)])
+    return vertices, faces
+
+
+def _discs(centres: np.ndarray, radius: float, z: float, sides: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of flat polygonal discs at height `z` around centres (K, 2)."""
+    angles = np.linspace(0.0, 2 * np.pi, sides, endpoint=False)
+    ring = radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    points = (centres[:, None, :] + ring[None]).reshape(-1, 2)
+    vertices = np.column_stack([points, np.full(len(points), z)]).astype(np.float32)
+    fan = np.array([[0, i, i + 1] for i in range(1, sides - 1)], dtype=np.uint32)
+    faces = (sides * np.arange(len(centres), dtype=np.uint32)[:, None, None] + fan[None]).reshape(-1, 3)
+    return vertices, faces
 
 
 class RobotScene:
@@ -116,30 +150,28 @@ class RobotScene:
         self.show(first)
 
     def _add_static(self, scene: viser.SceneApi) -> None:
-        """Terrain, the reference and actual body paths and the footholds."""
+        """Terrain, the reference and actual body paths and the footholds. Plain meshes: viser's
+        grid and line primitives cost several times more per frame in software WebGL."""
         run = self.run
         path = run.body_path()
         keep = decimation(len(path), PATH_POINTS)
-        ground = path[keep].copy()
-        ground[:, 2] = 0.004
         holds = run.footholds()
         extent = np.vstack([path[:, :2], holds[:, :2]]) if len(holds) else path[:, :2]
-        lo, hi = extent.min(axis=0) - 1.0, extent.max(axis=0) + 1.0
-        centre = (lo + hi) / 2
-        size = np.ceil(hi - lo)
-        # Terrain: the flat ground z = 0 of the contact model.
-        scene.add_grid("/terrain", width=float(size[0]), height=float(size[1]), plane="xy", cell_size=0.1, section_size=1.0, plane_color=(235, 232, 225), plane_opacity=1.0, position=(float(centre[0]), float(centre[1]), 0.0))
-        if len(ground) > 1:
-            scene.add_line_segments("/paths/body", np.stack([ground[:-1], ground[1:]], axis=1), colors=PATH_COLOUR, thickness=2.0, thickness_units="screen")
-        if run.reference_xy is not None:
-            ref = run.reference_xy[keep]
-            ref3 = np.column_stack([ref, np.full(len(ref), 0.002)])
-            if len(ref3) > 1:
-                scene.add_line_segments("/paths/reference", np.stack([ref3[:-1], ref3[1:]], axis=1), colors=REFERENCE_COLOUR, thickness=6.0, thickness_units="screen")
+        lo, hi = np.floor(extent.min(axis=0) - 1.0), np.ceil(extent.max(axis=0) + 1.0)
+        # Terrain: the flat ground z = 0 of the contact model, marked with a cross every 0.5 m
+        # (a lit ground plane or grid lines across the view cost half the frame rate in
+        # software WebGL).
+        xs, ys = np.meshgrid(np.arange(lo[0], hi[0] + 1e-9, GRID_STEP), np.arange(lo[1], hi[1] + 1e-9, GRID_STEP))
+        arm = np.array([GRID_CROSS / 2, 0.0])
+        crosses = [np.array([c - arm, c + arm]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
+        crosses += [np.array([c - arm[::-1], c + arm[::-1]]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
+        scene.add_mesh_simple("/terrain", *_ribbons(crosses, 0.004, 0.0), color=GRID_COLOUR, cast_shadow=False, side="double")
+        if len(keep) > 1:
+            scene.add_mesh_simple("/paths/body", *_ribbons([path[keep, :2]], 0.01, 0.003), color=PATH_COLOUR, cast_shadow=False, side="double")
+        if run.reference_xy is not None and len(keep) > 1:
+            scene.add_mesh_simple("/paths/reference", *_ribbons([run.reference_xy[keep]], 0.04, 0.002), color=REFERENCE_COLOUR, cast_shadow=False, side="double")
         if len(holds):
-            marks = holds.copy()
-            marks[:, 2] = np.maximum(marks[:, 2], 0.0) + 0.001
-            scene.add_point_cloud("/footholds", points=marks.astype(np.float32), colors=FOOTHOLD_COLOUR, point_size=0.02, point_shape="circle")
+            scene.add_mesh_simple("/footholds", *_discs(holds[:, :2], FOOTHOLD_RADIUS, 0.001), color=FOOTHOLD_COLOUR, cast_shadow=False, side="double")
 
     def show(self, frame: Frame) -> None:
         """Moves the robot, its feet and the force arrows to `frame`."""
