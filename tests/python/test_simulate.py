@@ -233,7 +233,7 @@ def test_walking_scenario(tmp_path: Path):
         "cycle": "enhanced",
         "heading": "constant",
         "navigation": False,
-        "clearance_m": 0.045,
+        "clearance_m": 0.105,
         "body_height_m": pytest.approx(0.414, abs=1e-3),
         "changes": 0,
     }

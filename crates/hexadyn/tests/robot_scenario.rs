@@ -365,7 +365,7 @@ fn walking_scenarios_parse() {
     assert_eq!(g.options.period, 12.0);
     assert_eq!((g.options.pattern.name.as_str(), g.options.pattern.beta), ("tripod", 0.5));
     assert_eq!(g.options.cycle, FootCycle::Enhanced { overlap: 0.05 });
-    assert_eq!((g.options.aep, g.options.lift, g.navigation), (AepMode::Periodic, 0.045, false));
+    assert_eq!((g.options.aep, g.options.lift, g.navigation), (AepMode::Periodic, 0.105, false));
     match &g.heading {
         HeadingSpec::Constant(h) => assert_eq!((h.velocity.x, h.velocity.y, h.yaw_rate), (0.015, 0.0, 0.0)),
         h => panic!("{h:?}"),
@@ -431,9 +431,9 @@ fn gait_errors_name_the_field() {
     assert!(s.contains("0.1") && s.contains(">= 0.1333"), "{s}");
     let s = field_error(&with(v, "period_s = 12.0", "period = 12.0"), "gait.period");
     assert!(s.contains("unknown field") && s.contains("period_s"), "{s}");
-    let s = field_error(&with(v, "clearance_m = 0.045", "clearance_m = 0.3"), "gait.clearance_m");
+    let s = field_error(&with(v, "clearance_m = 0.105", "clearance_m = 0.3"), "gait.clearance_m");
     assert!(s.contains("0.3") && s.contains("a clearance in (0, 0.12"), "{s}");
-    let s = field_error(&with(v, "clearance_m = 0.045", "clearance_m = 0.045\nbody_height_m = 0.6"), "gait.body_height_m");
+    let s = field_error(&with(v, "clearance_m = 0.105", "clearance_m = 0.105\nbody_height_m = 0.6"), "gait.body_height_m");
     assert!(s.contains("0.6") && s.contains("(0.2939, 0.5040)"), "{s}");
 
     // The stroke must fit the workspace: 5 cm/s x 8.4 s = 0.42 m > 2 x 0.148 m.
@@ -574,9 +574,10 @@ fn gait_runs_record_the_walk_deterministically() {
     assert!((x_ref[500] - 0.015 * (5.0 - 0.005)).abs() < 1e-9, "{}", x_ref[500]);
     assert!((x[500] - x_ref[500]).abs() < 2e-3, "{} vs {}", x[500], x_ref[500]);
     assert!(series.values("duty_factor").unwrap().iter().all(|&b| b == 0.5));
-    // Leg 1 lifts its foot reference by the clearance at mid-swing (t = 3 s).
+    // Leg 1 lifts its foot reference by the clearance (10.5 cm, docs/validation-walk.md) at
+    // mid-swing (t = 3 s).
     let z = series.values("foot_ref_z[1]").unwrap();
-    assert!((z[at(3.0)] - z[0] - 0.045).abs() < 1e-3, "{}", z[at(3.0)] - z[0]);
+    assert!((z[at(3.0)] - z[0] - 0.105).abs() < 1e-3, "{}", z[at(3.0)] - z[0]);
 
     let g = a.summary.gait.as_ref().expect("gait summary");
     assert!(g.tracking_error_xy_max_m < 2e-3 && g.tracking_error_xy_final_m <= g.tracking_error_xy_max_m, "{g:?}");
