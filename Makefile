@@ -28,9 +28,10 @@ help:
 	@echo "make lock   re-resolve requirements/lock.txt"
 	@echo "make clean  remove .venv and the Cargo target directory"
 
-setup: $(BUILD_STAMP) chromium
+setup: $(BUILD_STAMP)
 
-# The viewer's browser tests drive Debian's chromium (Playwright cannot download its own here).
+# The viewer's browser tests drive Debian's chromium (Playwright cannot download its own here);
+# `make test` installs it where it is missing (as root, the CI machine), `make run` does not need it.
 chromium:
 	@command -v chromium >/dev/null || { apt-get update -qq && apt-get install -y -qq chromium; }
 
@@ -52,7 +53,7 @@ $(BUILD_STAMP): $(DEPS_STAMP) $(RUST_SOURCES)
 run: setup
 	$(VENV)/bin/hexadyn simulate
 
-test: setup test-rust test-python
+test: setup chromium test-rust test-python
 
 test-rust:
 	$(CARGO) test --workspace --release --exclude hexadyn-py
