@@ -139,7 +139,7 @@ fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interru
     // Everything is built before the link starts: the first deadline must not wait on it.
     let mut controller = ScenarioController::new(s);
     let gait = controller.gait_columns();
-    let pi = controller.tracks_references(s);
+    let pi = s.control.tracks_references();
     let resistance = s.robot.circuit_resistance_ohm();
     let mut row = Row { rec: Recorder::default(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
     let mut plant = UdpPlant::connect(config, &s.robot, interrupt)?;

@@ -1,19 +1,18 @@
 //! The parts of a scenario run that other drivers reuse: the scenario's controller with its
 //! recorded gait columns, and its simulated robot at the settled start. The robot link runs
 //! the same controller on the real robot ([`crate::link::run`]) and the emulator its slaves on
-//! the same simulated robot ([`crate::link::emulator`]); [`super::run_scenario`] is built from
-//! the same two functions, so a linked run starts and is controlled as a simulated one.
+//! the same simulated robot ([`crate::link::emulator`], through [`super::settled_robot`]);
+//! [`super::run_scenario`] is built from the same two functions, so a linked run starts and is controlled as a simulated one.
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use super::run::{controller, settled_robot as settled};
-use super::{ControlMode, Scenario, ScenarioError};
+use super::run::controller;
+use super::Scenario;
 use crate::control::gait::schedule::GaitState;
 use crate::control::{Command, Controller, Measurements};
 use crate::robot::columns::record_gait;
 use crate::robot::recorder::Recorder;
-use crate::robot::simulation::SimulatedRobot;
 
 /// The controller a scenario runs (gait, PI loops or unpowered), as in [`super::run_scenario`].
 pub struct ScenarioController {
@@ -25,11 +24,6 @@ impl ScenarioController {
     pub fn new(s: &Scenario) -> Self {
         let (controller, gait) = controller(s);
         ScenarioController { controller, gait }
-    }
-
-    /// Whether the controller tracks joint references (PI and gait modes).
-    pub fn tracks_references(&self, s: &Scenario) -> bool {
-        matches!(s.control, ControlMode::Pi | ControlMode::Gait)
     }
 
     /// The recorder of the gait columns, which stays readable while the controller is driven.
@@ -55,10 +49,4 @@ impl Controller for ScenarioController {
     fn update(&mut self, m: &Measurements) -> Command {
         self.controller.update(m)
     }
-}
-
-/// The scenario's simulated robot at its start: feet on the ground, settled in static
-/// equilibrium with the joints locked when the scenario says so, body height offset added.
-pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot, ScenarioError> {
-    settled(s)
 }

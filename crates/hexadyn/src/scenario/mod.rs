@@ -59,7 +59,8 @@ mod summary;
 pub use crate::control::gait::schedule::GaitChange;
 pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
-pub use drivers::{settled_robot, GaitColumns, ScenarioController};
+pub use drivers::{GaitColumns, ScenarioController};
+pub use run::settled_robot;
 pub use run::{run_scenario, run_scenario_until, Record, ScenarioResults};
 pub use summary::{specific_resistance, GaitSummary, Summary, SummaryValue};
 
@@ -143,6 +144,12 @@ impl ControlMode {
             ControlMode::Unpowered => "unpowered",
             ControlMode::Gait => "gait",
         }
+    }
+
+    /// Whether the controller tracks joint references (the PI loops of modes `pi` and `gait`),
+    /// so that references and tracking errors are recorded.
+    pub fn tracks_references(self) -> bool {
+        matches!(self, ControlMode::Pi | ControlMode::Gait)
     }
 }
 

@@ -55,7 +55,7 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
     let (mut controller, gait_state) = controller(s);
 
     // The joint references are recorded and tracked by the PI loops in these modes.
-    let pi = matches!(s.control, ControlMode::Pi | ControlMode::Gait);
+    let pi = s.control.tracks_references();
     let groups = ColumnGroups { references: pi, bristles: s.model.friction == FrictionModel::LuGre };
     let supply = s.model.supply_voltage;
     let mut rec = Recorder::default();
@@ -91,7 +91,7 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
 /// The simulated robot at the start: feet on the ground, static equilibrium with the joints
 /// locked (Section 6.2) unless `initial.settle` is off, then the body raised by
 /// `initial.body_height_offset`.
-pub(super) fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
+pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
     let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
     let mut q = model.touching_ground(&s.initial.joints);
     let mut qd = vec![0.0; q.len()];

@@ -2,7 +2,7 @@
 //! [`GaitSummary`]), accumulated control instant by control instant while the scenario runs.
 
 use super::gait::GaitScenario;
-use super::{ControlMode, Scenario};
+use super::Scenario;
 use crate::control::gait::controller::GaitDiagnostics;
 use crate::control::gait::pattern::FootCycle;
 use crate::control::gait::schedule::GaitState;
@@ -302,7 +302,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         max_abs_voltage_v: stats.max_abs_voltage,
         saturated_fraction: if stats.commands > 0 { stats.saturated as f64 / stats.commands as f64 } else { 0.0 },
         limit_switch_cuts: stats.cuts,
-        max_tracking_error: matches!(s.control, ControlMode::Pi | ControlMode::Gait).then_some(stats.tracking),
+        max_tracking_error: s.control.tracks_references().then_some(stats.tracking),
         max_penetration_m: stats.max_penetration,
         gait: None,
     }
