@@ -10,9 +10,8 @@ use std::io::Write;
 use std::path::Path;
 
 use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{
-    Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType, ScalarType,
-};
+use ply_rs_bw::ply::{Addable, DefaultElement, ElementDef, Ply, Property, PropertyDef, PropertyType, ScalarType};
+pub use ply_rs_bw::ply::Encoding;
 use ply_rs_bw::writer::Writer;
 
 use super::{MeshError, MeshTerrain, Triangles};
