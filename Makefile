@@ -67,6 +67,7 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin gait
 	$(CARGO) run --release -p hexadyn-benches --bin walk
 	$(CARGO) run --release -p hexadyn-benches --bin link
+	$(CARGO) run --release -p hexadyn-benches --bin terrain
 
 # Optional: the full campaign (1000 runs x 4 velocities x 2 variants) takes hours on a laptop.
 bench-montecarlo: setup
