@@ -11,7 +11,10 @@ import numpy as np
 import pytest
 
 import hexadyn
-from hexadyn import _core
+from hexadyn import _core, report
+from hexadyn.view.data import Run
+
+from conftest import shortened
 
 TERRAINS = hexadyn.SCENARIOS_DIR / "terrains"
 
@@ -68,3 +71,14 @@ def test_analytic_grounds_are_squares(tmp_path: Path):
         _core.terrain_triangles(str(hexadyn.SCENARIOS_DIR / "tripod_low_step.toml"), half_width_m=-1.0)
     with pytest.raises(ValueError, match=r"terrain\.file"):
         _core.terrain_triangles(str(hexadyn.SCENARIOS_DIR / "tripod_low_step.toml"), overrides={"terrain": {"kind": "mesh", "file": "terrains/none.ply"}})
+
+
+def test_the_viewer_draws_a_ground_that_is_not_flat(tmp_path: Path):
+    step = shortened("tripod_low_step", tmp_path, duration=0.1)
+    report.save(hexadyn.simulate(step, progress=False), tmp_path / "step")
+    vertices, faces = Run(tmp_path / "step").terrain(np.array([0.5, 0.0]), 2.0)
+    assert vertices.dtype == np.float32 and faces.shape == (6, 3)
+    assert np.isclose(vertices[:, 2].max(), 0.03)
+    flat = shortened("validation_tripod_1_5cm", tmp_path, duration=0.1)
+    report.save(hexadyn.simulate(flat, progress=False), tmp_path / "flat")
+    assert Run(tmp_path / "flat").terrain(np.array([0.0, 0.0]), 2.0) is None
