@@ -22,6 +22,7 @@
 //! | `foot_ref_x[l]`, `foot_ref_y[l]`, `foot_ref_z[l]` | m | foot reference in the leg frame (gait) |
 //! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
 //! | `i_q_v[i]` ... | A | motor current |
+//! | `i_meas_q_v[i]` ... | A | motor current as the controller measured it at t: through the analog 30 Hz filter, with the sensor noise (Section 5.6.2, [`crate::physics::CurrentSensors`]) |
 //! | `tau_m_q_v[i]` ... | Nm (q_r), N | motor torque at the joint, n k_t i |
 //! | `tau_f_q_v[i]` ... | Nm (q_r), N | joint friction torque |
 //! | `z_q_v[i]` ... | rad (q_r), m | LuGre bristle deflection (friction `lugre` only) |
@@ -88,6 +89,9 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     }
     for k in 0..JOINTS {
         rec.put(out.current[k], || (joint_name("i_", k, ""), "A", s("motor current")));
+    }
+    for k in 0..JOINTS {
+        rec.put(meas.currents[k], || (joint_name("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
     }
     for k in 0..JOINTS {
         rec.put(out.motor_torque[k], || (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
