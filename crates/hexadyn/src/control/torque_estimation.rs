@@ -67,11 +67,8 @@ impl TorqueEstimator {
     pub fn new(d: &RobotDescription, dt: f64, cutoff_hz: f64) -> Self {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
         let data = Data::new(&mechanics.model);
-        let friction = std::array::from_fn(|k| {
-            let p = d.friction(k / 3, Joint::ALL[k % 3]);
-            // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters of Table 5.3.
-            DryViscous { tau_f_d_plus: p.tau_f_d_plus, tau_f_d_minus: p.tau_f_d_minus, f_v_plus: p.f_v_plus, f_v_minus: p.f_v_minus, epsilon: p.epsilon }
-        });
+        // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters of Table 5.3.
+        let friction = std::array::from_fn(|k| d.friction(k / 3, Joint::ALL[k % 3]).dry_viscous());
         TorqueEstimator {
             mechanics,
             data,
