@@ -141,6 +141,7 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
     _echo_power(results)
+    _echo_ground_detection(results)
     if not no_plots:
         click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
 
@@ -162,6 +163,38 @@ def _echo_power(results: hexadyn.Results) -> None:
     block = table.loc[energy.ALL].rename(index=lambda leg: f"leg {leg}" if leg != energy.TOTAL else leg).rename_axis(index=None, columns=None)
     for line in block.to_string(float_format=lambda v: f"{v:7.3f}").splitlines():
         click.echo(f"    {line}")
+
+
+def _echo_ground_detection(results: hexadyn.Results) -> None:
+    """Table 5.7 of a ground detection run."""
+    from hexadyn import ground_detection
+
+    if not ground_detection.has_experiment(results):
+        return
+    stops = ground_detection.trials(results)
+    click.echo(f"  ground detection: {len(stops)} stops; true force at the stop (N) and error eps_F = (threshold - F) / threshold (%), Table 5.7:")
+    if not stops.empty:
+        for line in ground_detection.format_table(ground_detection.table(stops)).splitlines():
+            click.echo(f"    {line}")
+
+
+@cli.command("ground-detection")
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path))
+def ground_detection_table(folder: Path) -> None:
+    """Table 5.7 of the ground detection results FOLDER (a run of control mode
+    ground_detection, e.g. `hexadyn simulate ground_detection`): the true contact force at each
+    stop on a detection, per leg and threshold, with the mean and standard deviation of the
+    error; written to FOLDER/ground_detection.csv and FOLDER/ground_detection_table.csv."""
+    from hexadyn import atomic, ground_detection, report
+
+    results = hexadyn.Results.load(folder)
+    if not ground_detection.has_experiment(results):
+        raise click.ClickException(f"{folder}: not the results of a ground detection run (control.mode = \"ground_detection\"; no gd_stop column)")
+    stops = ground_detection.trials(results)
+    atomic.write_file(folder / ground_detection.TRIALS_FILE, lambda p: report.write_csv(p, stops.set_index(["leg", "threshold_n", "trial"])))
+    atomic.write_file(folder / ground_detection.TABLE_FILE, lambda p: report.write_csv(p, ground_detection.table(stops)))
+    _echo_ground_detection(results)
+    click.echo(f"Tables: {folder / ground_detection.TRIALS_FILE}, {folder / ground_detection.TABLE_FILE}")
 
 
 @cli.command()

@@ -12,7 +12,10 @@ backends. Figures display in Jupyter as they are.
 - :func:`averaged_power_figure`: averaged power per actuator split by foot phase
   (Tables 6.3-6.6 as a chart);
 - :func:`energy_breakdown_figure`: electrical energy of each actuator split into Joule losses,
-  friction work and mechanical work.
+  friction work and mechanical work;
+- :func:`ground_detection_figure`: the ground detection experiment (Section 5.6.3): estimated
+  and true ground force of a tested leg around its first stop, with its vertical joint
+  (Fig. 5.17).
 
 :func:`figures` builds those the results support (the gait diagram and the trajectory need a
 walking scenario) and :func:`save_figures` writes them as 300 dpi PNG and, on request, vector
@@ -31,7 +34,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from hexadyn import energy
+from hexadyn import energy, ground_detection
 from hexadyn.vocabulary import JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
@@ -85,6 +88,7 @@ __all__ = [
     "energy_breakdown_figure",
     "figures",
     "gait_diagram",
+    "ground_detection_figure",
     "joint_figure",
     "parse_legs",
     "save_figures",
@@ -349,7 +353,44 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
         out["trajectory"] = trajectory_figure(results)
     out["averaged_power"] = averaged_power_figure(results)
     out["energy_breakdown"] = energy_breakdown_figure(results)
+    if ground_detection.has_experiment(results):
+        out["ground_detection"] = ground_detection_figure(results)
     return out
+
+
+def ground_detection_figure(results: Results, leg: int | None = None) -> Figure:
+    """Fig. 5.17: the ground force F_z,gnd estimated from the motor current (Eq. 5.22) and the
+    simulated normal force on the foot, from 3 s before to 5 s after the first stop of ``leg``
+    (default: the first leg that stopped), the threshold dashed; below, the vertical joint q_v
+    and its reference (the reference is held at the stop, then the sawtooth resumes)."""
+    trials = ground_detection.trials(results)
+    if trials.empty:
+        raise ValueError("no stop on a detection in these results")
+    leg = int(trials["leg"].iloc[0]) if leg is None else leg
+    _check_leg(leg)
+    first = trials[trials["leg"] == leg]
+    if first.empty:
+        raise ValueError(f"leg {leg} never stopped on a detection; legs that did: {sorted(set(trials['leg']))}")
+    t0, threshold = float(first["t_s"].iloc[0]), float(first["threshold_n"].iloc[0])
+    ts = results.timeseries.loc[t0 - 3.0 : t0 + 5.0]
+    t = ts.index.to_numpy()
+    with style():
+        fig = Figure(figsize=(6.3, 4.2))
+        top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
+        top.plot(t, ts[f"F_gnd_est[{leg}]"], color=SIMULATED, label="estimated $F_{z,gnd}$ (Eq. 5.22)")
+        top.plot(t, ts[leg_column("Fn", leg)], color="#c0392b", label="true normal force")
+        top.axhline(threshold, color=REFERENCE, linestyle="--", label=f"threshold {threshold:g} N")
+        top.axvline(t0, color="0.6", linewidth=0.6)
+        top.set_ylabel("ground force [N]")
+        top.legend(loc="upper left", frameon=False)
+        bottom.plot(t, ts[leg_column("q_v", leg)] * 1e3, color=SIMULATED, label="$q_v$")
+        bottom.plot(t, ts[leg_column("q_v_ref", leg)] * 1e3, color=REFERENCE, linestyle="--", label="reference")
+        bottom.set_ylabel("$q_v$ [mm]")
+        bottom.set_xlabel("time [s]")
+        bottom.legend(loc="upper left", frameon=False)
+        bottom.set_xlim(t[0], t[-1])
+        fig.suptitle(f"{_title(results)}: ground detection, leg {leg}")
+    return fig
 
 
 def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS) -> list[Path]:

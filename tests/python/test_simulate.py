@@ -44,6 +44,7 @@ SHIPPED = {
     "gait_changes",
     "tripod_rough_ground",
     "tripod_low_step",
+    "ground_detection",
 }
 
 

@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 24] = [
+const ALL: [&str; 25] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -65,6 +65,7 @@ const ALL: [&str; 24] = [
     "gait_changes",
     "tripod_rough_ground",
     "tripod_low_step",
+    "ground_detection",
 ];
 
 #[test]

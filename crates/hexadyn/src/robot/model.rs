@@ -20,7 +20,7 @@ use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Terrain};
-use crate::physics::{DryViscous, FrictionElement, JointFriction, LuGre, SteadyState};
+use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
@@ -120,12 +120,11 @@ pub struct RobotModel {
 
 fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
     // The description's parameters carry the thesis names of the laws' parameters.
-    let JointFrictionParameters {
-        tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, epsilon, load_dependence, ..
-    } = d.friction(leg, joint);
+    let parameters = d.friction(leg, joint);
+    let JointFrictionParameters { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, load_dependence, .. } = parameters;
     let law = match options.friction {
         FrictionModel::None => JointFriction::None,
-        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_f_d_plus, tau_f_d_minus, f_v_plus, f_v_minus, epsilon }),
+        FrictionModel::DryViscous => JointFriction::DryViscous(parameters.dry_viscous()),
         FrictionModel::LuGre => {
             // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
             // (horizontal, viscous effects neglected).

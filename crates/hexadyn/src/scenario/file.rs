@@ -15,7 +15,7 @@ use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
 use super::terrain::{self, RawTerrain};
 use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
-use crate::control::JointMotion;
+use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
 use crate::hexapod::{Joint, JOINTS};
@@ -41,6 +41,18 @@ pub(super) struct RawScenario {
     control: RawControl,
     gait: Option<RawGait>,
     terrain: Option<RawTerrain>,
+    #[serde(default)]
+    sensors: RawSensors,
+    ground_detection: Option<GroundExperiment>,
+}
+
+/// `[sensors]`: the current sensors of the plant (Section 5.6.2).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSensors {
+    current_noise_a: Option<f64>,
+    #[serde(default)]
+    seed: u64,
 }
 
 /// `[scenario]`.
@@ -269,6 +281,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     if let Some(g) = &gait {
         plant.navigation = g.navigation;
     }
+    if let Some(v) = raw.sensors.current_noise_a {
+        c.non_negative("sensors.current_noise_a", v).map_err(e)?;
+        plant.current_sensing.noise_a = v;
+    }
+    plant.current_sensing.seed = raw.sensors.seed;
 
     // Initial configuration.
     let i = &raw.initial;
@@ -360,6 +377,17 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         motions.push(motion);
     }
 
+    let ground_detection = match (mode, &raw.ground_detection) {
+        (ControlMode::GroundDetection, Some(g)) => Some(validate_ground_detection(g, c, &robot, &initial).map_err(e)?),
+        (ControlMode::GroundDetection, None) => {
+            return Err(e(c.err("ground_detection", "<missing>", "missing table", "a [ground_detection] table with control.mode = \"ground_detection\" (see python/hexadyn/scenarios/ground_detection.toml)")));
+        }
+        (_, Some(_)) => {
+            return Err(e(c.err("ground_detection", "[ground_detection]", &format!("a [ground_detection] table with control.mode = \"{}\"", mode.name()), "control.mode = \"ground_detection\" with the table (or no table)")));
+        }
+        (_, None) => None,
+    };
+
     Ok(Scenario {
         name: h.name.clone(),
         description: h.description.clone(),
@@ -374,6 +402,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         motions,
         gait,
         terrain,
+        ground_detection,
         origin: origin.to_string(),
         text: text.to_string(),
     })
@@ -448,6 +477,41 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
         }
     };
     Ok(Motion { leg, joint, motion })
+}
+
+/// `[ground_detection]`: legs 0..5 each at most once, positive thresholds, at least one trial,
+/// a sawtooth inside the q_v stroke around the initial q_v of each tested leg, and a period of
+/// at least four control periods.
+fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &RobotDescription, initial: &Initial) -> std::result::Result<GroundExperiment, DescriptionError> {
+    if g.legs.is_empty() {
+        return Err(c.err("ground_detection.legs", "[]", "no leg to test", "a list of legs 0..5"));
+    }
+    for (n, &leg) in g.legs.iter().enumerate() {
+        let field = format!("ground_detection.legs[{n}]");
+        if leg >= 6 {
+            return Err(c.err(&field, leg, "no such leg", "a leg number 0..5"));
+        }
+        if g.legs[..n].contains(&leg) {
+            return Err(c.err(&field, leg, "listed twice", "each leg at most once"));
+        }
+        if initial.lifted_legs.contains(&leg) {
+            return Err(c.err(&field, leg, "a lifted leg", "a leg standing on the ground at the start (not in initial.lifted_legs)"));
+        }
+    }
+    if g.thresholds.is_empty() {
+        return Err(c.err("ground_detection.thresholds_n", "[]", "no threshold", "a list of forces > 0 (N), e.g. [40, 50, 60]"));
+    }
+    for (n, &f) in g.thresholds.iter().enumerate() {
+        c.positive(&format!("ground_detection.thresholds_n[{n}]"), f)?;
+    }
+    c.check(g.trials >= 1, "ground_detection.trials", g.trials as f64, "an integer >= 1")?;
+    let period = robot.controller.period_s;
+    c.check(g.period.is_finite() && g.period >= 4.0 * period, "ground_detection.period_s", g.period, &format!("a finite period >= {} s (four control periods)", 4.0 * period))?;
+    let (lo, hi) = robot.joint_range(Joint::Vertical);
+    let tol = STROKE_TOLERANCE * (hi - lo);
+    let room = g.legs.iter().map(|&l| initial.joints[3 * l + 1]).map(|q| (q - lo).min(hi - q)).fold(f64::INFINITY, f64::min);
+    c.check(g.amplitude > 0.0 && g.amplitude <= room + tol, "ground_detection.amplitude_m", g.amplitude, &format!("a value in (0, {}] m, so that q_v ± amplitude stays in the q_v stroke [{}, {}] m around initial.q_v_m", short(room), short(lo), short(hi)))?;
+    Ok(g.clone())
 }
 
 /// A number with at most 6 decimals, trailing zeros removed (0.4363323129985824 -> 0.436332).

@@ -41,7 +41,7 @@ use std::sync::Arc;
 
 use serde::Deserialize;
 
-use crate::control::JointMotion;
+use crate::control::{GroundExperiment, JointMotion};
 use crate::description::RobotDescription;
 use crate::fields::{Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
@@ -138,6 +138,10 @@ pub enum ControlMode {
     /// The gait controller of Chapter 7 (`[gait]` table): heading velocities, foot references,
     /// inverse kinematics and the same 18 PI loops.
     Gait,
+    /// The ground detection experiment of Section 5.6.3 (`[ground_detection]` table): the
+    /// tested legs lowered in a sawtooth onto the ground and stopped on the detection from the
+    /// motor currents, the same 18 PI loops.
+    GroundDetection,
 }
 
 impl ControlMode {
@@ -146,13 +150,14 @@ impl ControlMode {
             ControlMode::Pi => "pi",
             ControlMode::Unpowered => "unpowered",
             ControlMode::Gait => "gait",
+            ControlMode::GroundDetection => "ground_detection",
         }
     }
 
-    /// Whether the controller tracks joint references (the PI loops of modes `pi` and `gait`),
-    /// so that references and tracking errors are recorded.
+    /// Whether the controller tracks joint references (the PI loops of modes `pi`, `gait` and
+    /// `ground_detection`), so that references and tracking errors are recorded.
     pub fn tracks_references(self) -> bool {
-        matches!(self, ControlMode::Pi | ControlMode::Gait)
+        matches!(self, ControlMode::Pi | ControlMode::Gait | ControlMode::GroundDetection)
     }
 }
 
@@ -216,6 +221,8 @@ pub struct Scenario {
     pub gait: Option<GaitScenario>,
     /// The ground (`[terrain]`; flat at z = 0 without it).
     pub terrain: Arc<dyn Terrain>,
+    /// The ground detection experiment, in mode `ground_detection`.
+    pub ground_detection: Option<GroundExperiment>,
     /// The scenario file (or origin name).
     pub origin: String,
     /// The scenario text.

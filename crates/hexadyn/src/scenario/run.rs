@@ -11,7 +11,7 @@ use std::time::Instant;
 use super::summary::{summarize, GaitStats, RunStats};
 use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
 use crate::control::gait::schedule::GaitState;
-use crate::control::{joint_pis, Controller, JointPiController, JointReferences, Unpowered};
+use crate::control::{joint_pis, Controller, GroundDetector, GroundExperimentController, GroundExperimentState, JointPiController, JointReferences, Unpowered};
 use crate::robot::columns::{record_row, ColumnGroups};
 use crate::robot::model::{FrictionModel, Robot, RobotModel};
 use crate::robot::recorder::{Recorder, TimeSeries};
@@ -51,7 +51,7 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
     let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
     let mut plant = settled_robot(s)?;
     let q = plant.state().q.as_slice().to_vec();
-    let (mut controller, gait_state) = controller(s);
+    let (mut controller, Published { gait: gait_state, ground }) = controller(s);
 
     // The joint references are recorded and tracked by the PI loops in these modes.
     let pi = s.control.tracks_references();
@@ -64,7 +64,8 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
     let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
         let state = gait_state.as_ref().map(|g| g.borrow());
         if record == Record::TimeSeries {
-            record_row(&mut rec, p, meas, cmd, groups, state.as_deref());
+            let ground = ground.as_ref().map(|g| g.borrow());
+            record_row(&mut rec, p, meas, cmd, groups, state.as_deref(), ground.as_deref());
         }
         stats.observe(p, cmd, supply, pi);
         if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
@@ -112,20 +113,34 @@ pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
     SimulatedRobot::new(model, &q, &qd, &s.plant).map_err(|source| ScenarioError::Simulation { file: s.origin.clone(), stage: "the start", source, hint: "" })
 }
 
-/// The controller of the scenario's control mode and, walking, the state the gait controller
-/// publishes after each update.
-pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Option<Rc<RefCell<GaitState>>>) {
+/// What a scenario's controller publishes after each update, for the record.
+#[derive(Default)]
+pub(super) struct Published {
+    /// Walking: the gait controller's state.
+    pub gait: Option<Rc<RefCell<GaitState>>>,
+    /// The ground detection experiment's state.
+    pub ground: Option<Rc<RefCell<GroundExperimentState>>>,
+}
+
+/// The controller of the scenario's control mode and what it publishes.
+pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Published) {
     match s.control {
         ControlMode::Gait => {
             let g = s.gait.as_ref().expect("gait mode has a validated [gait]");
             let (controller, state) = g.controller(&s.robot);
-            (Box::new(controller), Some(state))
+            (Box::new(controller), Published { gait: Some(state), ground: None })
         }
         ControlMode::Pi => {
             let pis = joint_pis(&s.robot, s.plant.period);
             let motions = s.motions.iter().map(|m| (m.joint_index(), m.motion)).collect();
-            (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), None)
+            (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), Published::default())
         }
-        ControlMode::Unpowered => (Box::new(Unpowered), None),
+        ControlMode::Unpowered => (Box::new(Unpowered), Published::default()),
+        ControlMode::GroundDetection => {
+            let e = s.ground_detection.clone().expect("ground_detection mode has a validated [ground_detection]");
+            let detector = GroundDetector::new(&s.robot, s.plant.period, e.thresholds[0]).expect("a validated description has valid leg kinematics");
+            let (controller, state) = GroundExperimentController::new(e, joint_pis(&s.robot, s.plant.period), s.initial.joints, detector);
+            (Box::new(controller), Published { gait: None, ground: Some(state) })
+        }
     }
 }
