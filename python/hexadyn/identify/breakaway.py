@@ -11,6 +11,10 @@ zone of Eq. 6.4). The velocity is the least-squares slope of the encoder positio
 +- ``smoothing_s``; the friction torque is smoothed over the same window (a Savitzky-Golay
 line, exact on the linear rise of the current, which also averages the current noise); tau_f,s
 is its extreme (largest for the plus sense, smallest for the minus one) up to the breakaway.
+
+A joint that moves before the voltage could have moved it — from the start, or against the
+voltage — is reversible under its load: its breakaway is not identified (the "-" of Table
+5.4: "joint is reversible"), and the measurement says so instead of giving a number.
 """
 
 from __future__ import annotations
@@ -34,7 +38,8 @@ class BreakawayOptions:
 
 @dataclass(frozen=True)
 class Breakaway:
-    """One breakaway measurement: tau_f,s, its direction, the instant and the foot load."""
+    """One breakaway measurement: tau_f,s (NaN when not identified, then `reason` says why), its
+    direction (the voltage's), the instant and the foot load."""
 
     source: str
     leg: int
@@ -42,13 +47,14 @@ class Breakaway:
     load_kg: float
     tau_f_s: float
     t_breakaway: float
+    reason: str = ""
 
 
 def breakaway(log: Log, leg: int, options: BreakawayOptions, joint: str = "q_v") -> Breakaway:
     """tau_f,s of one joint driven by a voltage ramp.
 
     Raises:
-        IdentifyError: the joint never breaks away in the log, or breaks away at once.
+        IdentifyError: the joint never moves in the log.
     """
     where = f"{log.source}: {joint}[{leg}]"
     t = log.t
@@ -63,9 +69,12 @@ def breakaway(log: Log, leg: int, options: BreakawayOptions, joint: str = "q_v")
     if len(moving) == 0:
         raise IdentifyError(f"{where}: the joint never reaches {options.breakaway_velocity} (breakaway velocity): no breakaway in the log (a longer ramp?)")
     k = int(moving[0])
-    if k < length:
-        raise IdentifyError(f"{where}: the joint moves from the start (t = {t[k]:.2f} s): no sticking phase before the breakaway")
-    direction = 1 if velocity[k] > 0 else -1
+    moved = 1 if velocity[k] > 0 else -1
+    voltage = f"u_{joint}[{leg}]"
+    direction = int(np.sign(log.frame[voltage].iloc[-1])) if voltage in log.frame and log.frame[voltage].iloc[-1] != 0 else moved
+    if k < length or moved != direction:
+        why = "from the start" if k < length else "against the voltage"
+        return Breakaway(log.source, leg, direction, log.foot_load_kg[leg], float("nan"), float(t[k]), f"reversible: moves {why} (t = {t[k]:.2f} s)")
     tau = signal.savgol_filter(friction_torque(log, joint, leg, slice(0, k + 1)), length, 1, mode="interp")
     tau_f_s = float(tau.max() if direction > 0 else tau.min())
     return Breakaway(log.source, leg, direction, log.foot_load_kg[leg], tau_f_s, float(t[k]))

@@ -67,16 +67,16 @@ def _solve(X: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
 
 
 def _bootstrap(X: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
-    """Percentile interval of the pairs bootstrap (resamples that cannot determine p are
-    skipped)."""
+    """Percentile interval of the pairs bootstrap (resamples that cannot determine p, a
+    singular normal matrix, are skipped)."""
     rng = np.random.default_rng(seed)
     n, m = X.shape
-    draws = []
-    for _ in range(BOOTSTRAP_SAMPLES):
-        k = rng.integers(0, n, n)
-        if np.linalg.matrix_rank(X[k]) < m:
-            continue
-        draws.append(np.linalg.lstsq(X[k], y[k], rcond=None)[0])
-    draws = np.asarray(draws)
+    scale = np.where(np.abs(X).max(axis=0) > 0, np.abs(X).max(axis=0), 1.0)
+    k = rng.integers(0, n, (BOOTSTRAP_SAMPLES, n))
+    Xb, yb = X[k] / scale, y[k]
+    normal = np.einsum("bni,bnj->bij", Xb, Xb)
+    rhs = np.einsum("bni,bn->bi", Xb, yb)
+    ok = np.linalg.cond(normal) < 1e12
+    draws = np.linalg.solve(normal[ok], rhs[ok][..., None])[..., 0] / scale
     alpha = (1 - LEVEL) / 2
     return np.quantile(draws, [alpha, 1 - alpha], axis=0)

@@ -65,12 +65,13 @@ def joint_friction_fragment(ident: Identification) -> str:
             value = float(np.mean(values))
             kept = _physical(key, value)
             note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g} (Section 6.1)"
-            lines.append(f"{key} = {kept:.6g}{note}")
+            lines.append(f"{key} = {kept:.9g}{note}")
         if joint == "q_v":
             for b_dir, sign in ((1, "plus"), (-1, "minus")):
                 for load in sorted({b.load_kg for b in ident.breakaways}):
-                    values = [b.tau_f_s for b in ident.breakaways if b.direction == b_dir and b.load_kg == load]
-                    lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.q_v.stiction]): {np.mean(values):.6g} N")
+                    values = [b.tau_f_s for b in ident.breakaways if b.direction == b_dir and b.load_kg == load and not b.reason]
+                    if values:
+                        lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.q_v.stiction]): {np.mean(values):.6g} N")
     return "\n".join(lines) + "\n"
 
 

@@ -56,11 +56,11 @@ def experiment_of(log: Log, joint: str, leg: int) -> str | None:
     ``voltage_ramp``). In a CSV log, a joint with a voltage column whose position moves one
     way only is a breakaway record, a joint that reverses at least twice a sawtooth.
     """
-    if not log.has(joint, leg):
-        return None
     if log.motions is not None:
         kind = log.motions.get((joint, leg))
         return {"sawtooth": SAWTOOTH, "voltage_ramp": BREAKAWAY}.get(kind or "")
+    if not log.has(joint, leg):
+        return None
     q = log.position(joint, leg)
     steps = np.sign(np.diff(q))
     steps = steps[steps != 0]

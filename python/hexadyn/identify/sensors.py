@@ -52,10 +52,29 @@ class SensorModel:
         self.rng = np.random.default_rng(seed)
 
 
+def _period_mean_current(log: Log, joint: str, leg: int) -> np.ndarray:
+    """The mean motor current over each control period, what the analog filter sees (it
+    integrates the continuous current), from the engine's cumulative electrical energy
+    E_el = integral of u i dt under the held voltage u: (E_el(t_k) - E_el(t_k-1)) / (u_k dt).
+    The sampled current where the voltage is zero or the log has no energy column."""
+    f = log.frame
+    i = f[column("i", joint, leg)].to_numpy(dtype=float)
+    energy, voltage = f"E_el_{joint}[{leg}]", column("u", joint, leg)
+    if energy not in f or voltage not in f:
+        return i
+    u = f[voltage].to_numpy(dtype=float)
+    de = np.diff(f[energy].to_numpy(dtype=float), prepend=np.nan)
+    dt = np.diff(log.t, prepend=np.nan)
+    held = np.abs(u) > 1e-9
+    mean = np.where(held, de / np.where(held, u, 1.0) / dt, i)
+    mean[0] = i[0]
+    return mean
+
+
 def measure(log: Log, sensors: SensorModel) -> Log:
     """The log as the sensors read it: measured current columns ``i_meas_<joint>[leg]`` (noise,
-    30 Hz analog and, optionally, 3 Hz digital filtering) next to the true ones, and the
-    positions rounded to encoder counts. The identification then uses the measured currents."""
+    30 Hz analog and, optionally, 3 Hz digital filtering of the period-mean current) next to
+    the true ones, and the positions rounded to encoder counts. The identification then uses the measured currents."""
     frame = log.frame.copy()
     dt = float(np.median(np.diff(log.t)))
     added = {}
@@ -63,7 +82,7 @@ def measure(log: Log, sensors: SensorModel) -> Log:
         for leg in LEGS:
             if not log.has(joint, leg):
                 continue
-            i = log.frame[column("i", joint, leg)].to_numpy(dtype=float)
+            i = _period_mean_current(log, joint, leg)
             i = i + sensors.rng.normal(0.0, sensors.noise, len(i)) if sensors.noise > 0 else i
             i = low_pass(i, ANALOG_HZ, dt)
             if sensors.digital_filter:

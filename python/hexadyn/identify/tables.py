@@ -50,7 +50,7 @@ def table_5_4(ident: Identification) -> pd.DataFrame:
     for load in sorted({b.load_kg for b in ident.breakaways}):
         for direction, sign in ((1, "+"), (-1, "-")):
             rows[f"{load:g} kg: tau_f,s^{sign} (N)"] = [
-                x for leg in LEGS for x in mean_sigma([b.tau_f_s for b in ident.breakaways if b.leg == leg and b.direction == direction and b.load_kg == load])
+                x for leg in LEGS for x in mean_sigma([b.tau_f_s for b in ident.breakaways if b.leg == leg and b.direction == direction and b.load_kg == load and not b.reason])
             ]
     return pd.DataFrame.from_dict(rows, orient="index", columns=_leg_columns())
 
@@ -83,7 +83,7 @@ def estimates(ident: Identification) -> pd.DataFrame:
             rows.append(_row("loaded logs", "q_h", f.leg, f.direction, float("nan"), name, e, len(f.loads_kg)))
     for b in ident.breakaways:
         nan = float("nan")
-        rows.append(_row(b.source, "q_v", b.leg, b.direction, b.load_kg, "tau_f_s", Estimate(b.tau_f_s, nan, nan, nan, nan, nan), 1))
+        rows.append(_row(b.source, "q_v", b.leg, b.direction, b.load_kg, "tau_f_s", Estimate(b.tau_f_s, nan, nan, nan, nan, nan), 0 if b.reason else 1) | {"note": b.reason})
     return pd.DataFrame(rows)
 
 
