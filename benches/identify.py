@@ -20,8 +20,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 import hexadyn
 from hexadyn.identify import identify, load_log
 from hexadyn.identify.sensors import SensorModel, measure

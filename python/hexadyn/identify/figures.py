@@ -46,7 +46,9 @@ def friction_figure(ident: Identification, joint: str, load_kg: float = 0.0) -> 
             ax.set_title(panel)
             ax.set_xlabel(f"velocity ({speed_unit})")
             ax.set_ylabel(f"friction ({dry_unit})")
-        handles, labels = axes[1].get_legend_handles_labels() or axes[0].get_legend_handles_labels()
+        handles, labels = axes[1].get_legend_handles_labels()
+        if not handles:
+            handles, labels = axes[0].get_legend_handles_labels()
         if handles:
             fig.legend(handles, labels, loc="outside right center")
         load = "" if load_kg == 0 else f", {load_kg:g} kg at the foot"
