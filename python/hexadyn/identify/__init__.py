@@ -17,9 +17,24 @@ and confidence intervals), ``steady`` (Eq. 5.3-5.4, 5.12), ``breakaway`` (Eq. 5.
 ``command``.
 """
 
-from hexadyn.identify.breakaway import BreakawayOptions
-from hexadyn.identify.identification import Identification, identify
-from hexadyn.identify.logs import IdentifyError, Log, load_log
-from hexadyn.identify.sections import SectionOptions
+from importlib import import_module
+
+#: Public names -> their module, imported on first use: `hexadyn --help` and the other commands
+#: do not pay for numpy, pandas and scipy (the CLI registers `hexadyn.identify.command`).
+_EXPORTS = {
+    "BreakawayOptions": "breakaway",
+    "Identification": "identification",
+    "identify": "identification",
+    "IdentifyError": "logs",
+    "Log": "logs",
+    "load_log": "logs",
+    "SectionOptions": "sections",
+}
 
 __all__ = ["BreakawayOptions", "Identification", "IdentifyError", "Log", "SectionOptions", "identify", "load_log"]
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(import_module(f"{__name__}.{_EXPORTS[name]}"), name)
