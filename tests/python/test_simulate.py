@@ -48,6 +48,8 @@ SHIPPED = {
     "identification_breakaway_plus",
     "identification_breakaway_minus",
     "identification_loaded_q_h",
+    "tripod_rough_ground",
+    "tripod_low_step",
 }
 
 
