@@ -287,10 +287,11 @@ def scenarios() -> None:
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
 @click.option("--variants", default=None, help="Comma-separated friction variants (default: dry_viscous,dry_viscous_load).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
+@click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
 @click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_address, no_progress) -> None:
+def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, workers, ray_address, no_progress) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
     Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm) for every friction
@@ -315,6 +316,7 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_add
         runs_per_velocity=runs,
         variants=listed("--variants", variants, str.strip),
         seed=seed,
+        friction_stats=friction_stats,
     )
     try:
         table = campaign.run(out, workers=workers, ray=ray_address, progress=not no_progress)
@@ -349,6 +351,10 @@ def _one_line(exc: BaseException) -> str:
 from hexadyn.link.cli import robot  # noqa: E402  (the `hexadyn robot` commands)
 
 cli.add_command(robot)
+
+from hexadyn.identify.command import identify_command  # noqa: E402  (hexadyn identify: Chapter 5)
+
+cli.add_command(identify_command)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

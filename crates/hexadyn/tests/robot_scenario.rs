@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 25] = [
+const ALL: [&str; 31] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -63,6 +63,12 @@ const ALL: [&str; 25] = [
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "identification_q_r",
+    "identification_q_v",
+    "identification_q_h",
+    "identification_breakaway_plus",
+    "identification_breakaway_minus",
+    "identification_loaded_q_h",
     "tripod_rough_ground",
     "tripod_low_step",
     "ground_detection",

@@ -81,6 +81,13 @@ pub struct ModelOptions {
     /// Supply voltage at the H-bridges (V).
     pub supply_voltage: f64,
     pub control: JointControl,
+    /// The body held still on a stand (the identification rig of Section 5.2, "leg in the
+    /// air"): the six body rows of the residual become q''_body = 0.
+    pub stand: bool,
+    /// Upward force on each foot (N), the load of the identification rig (Fig. 5.6: 10 kg at
+    /// the foot playing the role of the ground reaction, Sections 5.3-5.4). It acts like a
+    /// ground force: it is added to the foot force and to the leg load of Eq. 5.12.
+    pub foot_load: [f64; 6],
 }
 
 impl ModelOptions {
@@ -94,6 +101,8 @@ impl ModelOptions {
             ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s, foot_radius: 0.0 },
             supply_voltage: d.driver.supply_voltage_v,
             control: JointControl::Digital,
+            stand: false,
+            foot_load: [0.0; 6],
         }
     }
 }
@@ -428,7 +437,10 @@ impl Robot {
         for (leg, bodies) in mech.legs.iter().enumerate() {
             let p = self.data.point(bodies.links[3], &mech.foot_local);
             let v = self.data.point_velocity(bodies.links[3], &p);
-            let c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            let mut c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v.
+            c.force.z += m.options.foot_load[leg];
+            c.normal_force += m.options.foot_load[leg];
             if c.force != Vector3::zeros() {
                 self.data.add_force(bodies.links[3], &p, &c.force);
             }
@@ -462,6 +474,9 @@ impl Robot {
         self.evaluate(q, qd, qdd);
         let m = &*self.model;
         mbs::residual(&m.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
+        if m.options.stand {
+            f[..BODY].copy_from_slice(&qdd[..BODY]);
+        }
         for k in 0..JOINTS {
             let j = 6 + k;
             if let Some(b) = m.bristles {
@@ -486,6 +501,9 @@ impl Robot {
     fn write_mass_matrix(&self, qd: &[f64], qdd: &[f64], mass: &mut DMatrix<f64>) {
         let m = &*self.model;
         mbs::mass_matrix(&m.mechanics.model, &self.data, mass);
+        if m.options.stand {
+            held_body_rows(mass, 1.0);
+        }
         for k in 0..JOINTS {
             let j = 6 + k;
             let load = self.outputs.contact[k / 3].normal_force;
@@ -623,6 +641,10 @@ impl System for Robot {
                 }
             }
         }
+        if m.options.stand {
+            held_body_rows(&mut jac.kt, 0.0);
+            held_body_rows(&mut jac.ct, 0.0);
+        }
         true
     }
 
@@ -647,6 +669,18 @@ impl System for Robot {
             None => self.voltages[k] = value,
             Some(_) => self.references[k] = value,
         }
+    }
+}
+
+/// Number of body coordinates (X, Y, Z, yaw, pitch, roll), first in q.
+const BODY: usize = 6;
+
+/// The body rows of a Jacobian block of the robot on a stand (f_body = q''_body): zero, with
+/// `diagonal` on the diagonal (1 for M, 0 for CT and KT).
+fn held_body_rows(block: &mut DMatrix<f64>, diagonal: f64) {
+    block.rows_mut(0, BODY).fill(0.0);
+    for i in 0..BODY {
+        block[(i, i)] = diagonal;
     }
 }
 

@@ -19,6 +19,7 @@ use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
 use crate::hexapod::{Joint, JOINTS};
+use crate::physics::LOAD_GRAVITY;
 use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
 
@@ -88,6 +89,9 @@ struct RawModel {
     supply_voltage_v: Option<f64>,
     #[serde(default)]
     joint_friction: RawJointFriction,
+    #[serde(default)]
+    stand: bool,
+    foot_load_kg: Option<Vec<f64>>,
 }
 
 fn default_friction() -> FrictionModel {
@@ -96,7 +100,7 @@ fn default_friction() -> FrictionModel {
 
 impl Default for RawModel {
     fn default() -> Self {
-        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, foot_radius_m: None, supply_voltage_v: None, joint_friction: Default::default() }
+        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, foot_radius_m: None, supply_voltage_v: None, joint_friction: Default::default(), stand: false, foot_load_kg: None }
     }
 }
 
@@ -170,6 +174,7 @@ enum MotionKind {
     Ramp,
     Sine,
     Sawtooth,
+    VoltageRamp,
 }
 
 /// One `[[control.motion]]`.
@@ -187,6 +192,9 @@ struct RawMotion {
     min: Option<f64>,
     max: Option<f64>,
     speed: Option<f64>,
+    speed_step: Option<f64>,
+    speed_max: Option<f64>,
+    rate_v_per_s: Option<f64>,
 }
 
 // =============================================================================================
@@ -252,6 +260,17 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     if let Some(v) = m.supply_voltage_v {
         c.positive("model.supply_voltage_v", v).map_err(e)?;
         model.supply_voltage = v;
+    }
+    model.stand = m.stand;
+    if let Some(loads) = &m.foot_load_kg {
+        let shown = format!("{loads:?}");
+        if loads.len() != 6 {
+            return Err(e(c.err("model.foot_load_kg", &shown, &format!("{} values", loads.len()), "six masses >= 0 (kg), one per leg 0..5")));
+        }
+        for (leg, &kg) in loads.iter().enumerate() {
+            c.non_negative(&format!("model.foot_load_kg[{leg}]"), kg).map_err(e)?;
+            model.foot_load[leg] = kg * LOAD_GRAVITY;
+        }
     }
 
     // Integrator.
@@ -426,9 +445,22 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
     let (kind, used): (&str, &[&str]) = match m.kind {
         MotionKind::Ramp => ("ramp", &["rate", "start_s", "stop_s"]),
         MotionKind::Sine => ("sine", &["amplitude", "frequency_hz"]),
-        MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed"]),
+        MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed", "speed_step", "speed_max"]),
+        MotionKind::VoltageRamp => ("voltage_ramp", &["rate_v_per_s"]),
     };
-    let fields = [("rate", m.rate), ("start_s", m.start_s), ("stop_s", m.stop_s), ("amplitude", m.amplitude), ("frequency_hz", m.frequency_hz), ("min", m.min), ("max", m.max), ("speed", m.speed)];
+    let fields = [
+        ("rate", m.rate),
+        ("start_s", m.start_s),
+        ("stop_s", m.stop_s),
+        ("amplitude", m.amplitude),
+        ("frequency_hz", m.frequency_hz),
+        ("min", m.min),
+        ("max", m.max),
+        ("speed", m.speed),
+        ("speed_step", m.speed_step),
+        ("speed_max", m.speed_max),
+        ("rate_v_per_s", m.rate_v_per_s),
+    ];
     for (name, value) in fields {
         if let Some(v) = value {
             if !used.contains(&name) {
@@ -473,7 +505,24 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
             c.check(min >= lo - tol && min <= base, &field("min"), min, &format!("a value in [{lo_s}, {base_s}] {unit}: within {stroke_text}, at most the base"))?;
             c.check(max <= hi + tol && max >= base && max > min, &field("max"), max, &format!("a value in [{base_s}, {hi_s}] {unit} and > min: within {stroke_text}, at least the base"))?;
             c.positive(&field("speed"), speed)?;
-            JointMotion::Sawtooth { min, max, speed }
+            // Optional staircase of Table 5.2: both keys or neither.
+            match (m.speed_step, m.speed_max) {
+                (None, None) => JointMotion::Sawtooth { min, max, speed },
+                (Some(speed_step), Some(speed_max)) => {
+                    c.positive(&field("speed_step"), speed_step)?;
+                    c.check(speed_max >= speed, &field("speed_max"), speed_max, &format!("a speed >= speed = {speed} {unit}/s"))?;
+                    JointMotion::SawtoothSteps { min, max, speed, speed_step, speed_max }
+                }
+                (Some(v), None) | (None, Some(v)) => {
+                    let name = if m.speed_step.is_some() { "speed_max" } else { "speed_step" };
+                    return Err(c.err(&field(name), "<missing>", "missing field", format!("speed_step and speed_max together (the speed staircase of Table 5.2; the other is {v})")));
+                }
+            }
+        }
+        MotionKind::VoltageRamp => {
+            let rate = required("rate_v_per_s", m.rate_v_per_s)?;
+            c.check(rate.is_finite() && rate != 0.0, &field("rate_v_per_s"), rate, "a finite, non-zero voltage rate (V/s; Section 5.3 uses 0.05, or -0.05 for the minus sense)")?;
+            JointMotion::VoltageRamp { rate_v_per_s: rate }
         }
     };
     Ok(Motion { leg, joint, motion })
