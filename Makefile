@@ -17,7 +17,7 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup chromium run test test-rust test-python bench bench-peer bench-montecarlo lock clean
+.PHONY: help setup chromium run test test-rust test-python bench bench-peer bench-montecarlo terrains lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
@@ -26,6 +26,7 @@ help:
 	@echo "make bench  run the engine benchmarks (release)"
 	@echo "make bench-peer  the 75 s walk in hexadyn and in MuJoCo, timed in the same run"
 	@echo "make bench-montecarlo [MC_ARGS=\"--runs 50\"]  time a Monte Carlo campaign on every core (long)"
+	@echo "make terrains  regenerate the shipped terrain PLY files (python/hexadyn/scenarios/terrains)"
 	@echo "make lock   re-resolve requirements/lock.txt"
 	@echo "make clean  remove .venv and the Cargo target directory"
 
@@ -68,6 +69,11 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin gait
 	$(CARGO) run --release -p hexadyn-benches --bin walk
 	$(CARGO) run --release -p hexadyn-benches --bin link
+	$(CARGO) run --release -p hexadyn-benches --bin terrain
+
+# The shipped terrains are generated, never drawn: physics::terrain::generate, written as PLY.
+terrains:
+	$(CARGO) run --release -p hexadyn --example make_terrains -- python/hexadyn/scenarios/terrains
 
 # The peer benchmark against MuJoCo (installed here, from the lock, as the `bench` extra: not a
 # dependency of hexadyn or of its tests).

@@ -42,6 +42,8 @@ SHIPPED = {
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "tripod_rough_ground",
+    "tripod_low_step",
 }
 
 

@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 22] = [
+const ALL: [&str; 24] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -63,13 +63,16 @@ const ALL: [&str; 22] = [
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "tripod_rough_ground",
+    "tripod_low_step",
 ];
 
 #[test]
 fn shipped_scenarios_are_valid() {
     let mut found: Vec<String> = std::fs::read_dir(scenarios_dir())
         .unwrap()
-        .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .filter_map(|e| Some(e.ok()?.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")))
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
         .collect();
     found.sort();
     let mut expected: Vec<String> = ALL.iter().map(|s| s.to_string()).collect();

@@ -1,5 +1,5 @@
 //! Physical elements of the robot model (thesis Section 3.4.2-3.4.4, Chapter 5, Section 6.1):
-//! ground contact, joint friction and DC motors.
+//! the terrain and the ground contact, joint friction and DC motors.
 //!
 //! Each element is a set of small pure functions returning its value with the exact partial
 //! derivatives with respect to each argument, from which the assembler of the global residual
@@ -8,8 +8,10 @@
 mod contact;
 mod friction;
 mod motor;
+pub mod terrain;
 
-pub use contact::{ContactForce, FlatGround, GroundContact, Slope, Terrain};
+pub use contact::{ContactForce, GroundContact};
+pub use terrain::{Extent, FlatGround, Heightfield, MeshTerrain, Proximity, Slope, Step, Terrain, Triangles};
 pub use friction::{
     BristleResidual, DryViscous, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,
     LOAD_GRAVITY,

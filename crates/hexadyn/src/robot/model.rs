@@ -91,7 +91,7 @@ impl ModelOptions {
             friction,
             load_dependence: false,
             inductance: false,
-            ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s },
+            ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s, foot_radius: 0.0 },
             supply_voltage: d.driver.supply_voltage_v,
             control: JointControl::Digital,
         }
@@ -108,7 +108,7 @@ pub struct RobotModel {
     /// Joint strokes (limit switches), per joint type.
     pub strokes: [RangeInclusive<f64>; 3],
     pub options: ModelOptions,
-    pub terrain: Arc<dyn Terrain + Send + Sync>,
+    pub terrain: Arc<dyn Terrain>,
     /// Continuous joint controllers (Eq. 3.96-3.97), with [`JointControl::ContinuousPid`].
     pub pids: Option<[ContinuousPid; JOINTS]>,
     layout: Layout,
@@ -145,7 +145,7 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &Mo
 }
 
 impl RobotModel {
-    pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain + Send + Sync>) -> Self {
+    pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
         let motor = |joint: Joint| DcMotor {
             r: d.motor.resistance_ohm,
@@ -222,22 +222,30 @@ impl RobotModel {
     }
 
     /// Initial q for the given joint positions: level body at (0, 0, Z), Z chosen so that the
-    /// lowest foot just touches the terrain; all other states zero.
+    /// lowest foot just touches the terrain (closest point: zero penetration); all other states
+    /// zero.
     pub fn touching_ground(&self, joints: &[f64; JOINTS]) -> Vec<f64> {
         let mut q = vec![0.0; self.coordinate_count()];
         q[6..DOF].copy_from_slice(joints);
         let mech = &self.mechanics;
         let mut data = Data::new(&mech.model);
-        mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
-        let clearance = mech
-            .legs
-            .iter()
-            .map(|b| {
-                let p = data.point(b.links[3], &mech.foot_local);
-                p.z - self.terrain.height_normal(p.x, p.y).0
-            })
-            .fold(f64::INFINITY, f64::min);
-        q[2] = -clearance;
+        let mut clearance = |q: &[f64]| {
+            mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
+            mech.legs
+                .iter()
+                .map(|b| -self.terrain.proximity(&data.point(b.links[3], &mech.foot_local), self.options.ground.foot_radius).penetration)
+                .fold(f64::INFINITY, f64::min)
+        };
+        q[2] = -clearance(&q);
+        // Off a plane the closest point is not below the foot: lowering the body by the
+        // clearance leaves a clearance >= 0 (the distance is 1-Lipschitz); repeat until touching.
+        for _ in 0..100 {
+            let c = clearance(&q);
+            if c.abs() <= 1e-12 {
+                break;
+            }
+            q[2] -= c;
+        }
         q
     }
 

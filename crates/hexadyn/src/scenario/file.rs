@@ -13,6 +13,7 @@ use serde::Deserialize;
 
 use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
+use super::terrain::{self, RawTerrain};
 use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
 use crate::control::JointMotion;
 use crate::description::{RobotDescription, AMRU5_TOML};
@@ -39,6 +40,7 @@ pub(super) struct RawScenario {
     #[serde(default)]
     control: RawControl,
     gait: Option<RawGait>,
+    terrain: Option<RawTerrain>,
 }
 
 /// `[scenario]`.
@@ -70,6 +72,7 @@ struct RawModel {
     k_gnd: Option<f64>,
     d_gnd: Option<f64>,
     mu: Option<f64>,
+    foot_radius_m: Option<f64>,
     supply_voltage_v: Option<f64>,
     #[serde(default)]
     joint_friction: RawJointFriction,
@@ -81,7 +84,7 @@ fn default_friction() -> FrictionModel {
 
 impl Default for RawModel {
     fn default() -> Self {
-        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None, joint_friction: Default::default() }
+        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, foot_radius_m: None, supply_voltage_v: None, joint_friction: Default::default() }
     }
 }
 
@@ -229,6 +232,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         c.non_negative("model.mu", v).map_err(e)?;
         model.ground.mu = v;
     }
+    if let Some(v) = m.foot_radius_m {
+        c.check((0.0..=0.05).contains(&v), "model.foot_radius_m", v, "a radius in [0, 0.05] m (0: the point foot of Section 3.4.2)").map_err(e)?;
+        model.ground.foot_radius = v;
+    }
+    let terrain = terrain::validate(raw.terrain.as_ref(), c, dir).map_err(e)?;
     if let Some(v) = m.supply_voltage_v {
         c.positive("model.supply_voltage_v", v).map_err(e)?;
         model.supply_voltage = v;
@@ -365,6 +373,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         control: mode,
         motions,
         gait,
+        terrain,
         origin: origin.to_string(),
         text: text.to_string(),
     })

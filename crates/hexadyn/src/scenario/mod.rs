@@ -37,6 +37,7 @@
 //! [`TimeSeries`]: crate::robot::recorder::TimeSeries
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::Deserialize;
 
@@ -46,6 +47,7 @@ use crate::fields::{Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
 use crate::robot::model::ModelOptions;
 use crate::robot::simulation::PlantOptions;
+use crate::physics::Terrain;
 use crate::sim::SimError;
 
 mod drivers;
@@ -55,6 +57,7 @@ mod joint_friction;
 mod overrides;
 mod run;
 mod summary;
+mod terrain;
 
 pub use crate::control::gait::schedule::GaitChange;
 pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
@@ -211,6 +214,8 @@ pub struct Scenario {
     pub motions: Vec<Motion>,
     /// The walking set-up, in gait mode.
     pub gait: Option<GaitScenario>,
+    /// The ground (`[terrain]`; flat at z = 0 without it).
+    pub terrain: Arc<dyn Terrain>,
     /// The scenario file (or origin name).
     pub origin: String,
     /// The scenario text.

@@ -12,7 +12,6 @@ use super::summary::{summarize, GaitStats, RunStats};
 use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
 use crate::control::gait::schedule::GaitState;
 use crate::control::{joint_pis, Controller, JointPiController, JointReferences, Unpowered};
-use crate::physics::FlatGround;
 use crate::robot::columns::{record_row, ColumnGroups};
 use crate::robot::model::{FrictionModel, Robot, RobotModel};
 use crate::robot::recorder::{Recorder, TimeSeries};
@@ -92,7 +91,7 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
 /// locked (Section 6.2) unless `initial.settle` is off, then the body raised by
 /// `initial.body_height_offset`.
 pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
-    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
+    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), s.terrain.clone()));
     let mut q = model.touching_ground(&s.initial.joints);
     let mut qd = vec![0.0; q.len()];
     if s.initial.settle {
