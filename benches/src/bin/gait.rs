@@ -35,7 +35,7 @@ fn main() {
     let d = RobotDescription::amru5();
     // One controller update, open loop on measurements that follow the references.
     let (mut c, joints) = controller(&d, 12.0, 0.015);
-    let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None };
+    let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
     let mut samples = Vec::new();
     for i in 0..30_000 {
         m.t = i as f64 * 0.01;
