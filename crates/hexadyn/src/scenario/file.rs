@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
-use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
+use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, TerrainSpec, DEFAULT_ROBOT};
 use crate::control::JointMotion;
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
@@ -73,6 +73,19 @@ struct RawModel {
     supply_voltage_v: Option<f64>,
     #[serde(default)]
     joint_friction: RawJointFriction,
+    #[serde(default)]
+    terrain: TerrainKind,
+    slope_deg: Option<f64>,
+    slope_azimuth_deg: Option<f64>,
+}
+
+/// `model.terrain`.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum TerrainKind {
+    #[default]
+    Flat,
+    Slope,
 }
 
 fn default_friction() -> FrictionModel {
@@ -81,7 +94,19 @@ fn default_friction() -> FrictionModel {
 
 impl Default for RawModel {
     fn default() -> Self {
-        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None, joint_friction: Default::default() }
+        RawModel {
+            friction: default_friction(),
+            load_dependence: false,
+            inductance: false,
+            k_gnd: None,
+            d_gnd: None,
+            mu: None,
+            supply_voltage_v: None,
+            joint_friction: Default::default(),
+            terrain: TerrainKind::Flat,
+            slope_deg: None,
+            slope_azimuth_deg: None,
+        }
     }
 }
 
@@ -234,6 +259,25 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         model.supply_voltage = v;
     }
 
+    // Terrain.
+    let terrain = match m.terrain {
+        TerrainKind::Flat => {
+            for (field, v) in [("model.slope_deg", m.slope_deg), ("model.slope_azimuth_deg", m.slope_azimuth_deg)] {
+                if let Some(v) = v {
+                    return Err(e(c.err(field, v, "not a field of terrain = \"flat\"", "with terrain = \"slope\" (or no slope field)")));
+                }
+            }
+            TerrainSpec::Flat
+        }
+        TerrainKind::Slope => {
+            let angle = m.slope_deg.ok_or_else(|| e(c.err("model.slope_deg", "<missing>", "missing field", "terrain = \"slope\" needs slope_deg, the inclination in [0, 45) degrees")))?;
+            c.check(angle.is_finite() && (0.0..45.0).contains(&angle), "model.slope_deg", angle, "an inclination in [0, 45) degrees (Section 7.7.5: 20)").map_err(e)?;
+            let azimuth = m.slope_azimuth_deg.unwrap_or(0.0);
+            c.finite("model.slope_azimuth_deg", azimuth).map_err(e)?;
+            TerrainSpec::Slope { angle: angle.to_radians(), azimuth: azimuth.to_radians() }
+        }
+    };
+
     // Integrator.
     let mut plant = PlantOptions::from_description(&robot, &model);
     if let Some(v) = raw.integrator.tolerance {
@@ -360,6 +404,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         robot_source,
         robot_text,
         model,
+        terrain,
         plant,
         initial,
         control: mode,

@@ -37,6 +37,7 @@
 //! [`TimeSeries`]: crate::robot::recorder::TimeSeries
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::Deserialize;
 
@@ -44,6 +45,7 @@ use crate::control::JointMotion;
 use crate::description::RobotDescription;
 use crate::fields::{Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
+use crate::physics::{FlatGround, Slope, Terrain};
 use crate::robot::model::ModelOptions;
 use crate::robot::simulation::PlantOptions;
 use crate::sim::SimError;
@@ -57,7 +59,7 @@ mod run;
 mod summary;
 
 pub use crate::control::gait::schedule::GaitChange;
-pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
+pub use gait::{FreeGaitSpec, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
@@ -93,7 +95,7 @@ pub enum ScenarioError {
     /// cause.
     #[error("{file}: {stage} failed: {source}{hint}")]
     Simulation { file: String, stage: &'static str, source: SimError, hint: &'static str },
-    /// The settled body tilts by more than 5°: the stance cannot carry it (it rests on lifted
+    /// The settled body tilts by more than 5° from the ground below it: the stance cannot carry it (it rests on lifted
     /// legs).
     #[error("{file}: settling tips the body over (pitch {pitch_deg:.1}°, roll {roll_deg:.1}°); check that the supporting feet surround the centre of mass (initial.lifted_legs)")]
     Tipped { file: String, pitch_deg: f64, roll_deg: f64 },
@@ -157,6 +159,26 @@ impl ControlMode {
 // The validated scenario
 // =============================================================================================
 
+/// The ground of a scenario. The terrains of the physics layer plug in here: a variant, its
+/// `[model] terrain` name in `file.rs`, and its [`Terrain`] in [`TerrainSpec::build`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TerrainSpec {
+    /// Horizontal ground at z = 0.
+    Flat,
+    /// A plane through the origin rising at `angle` (rad) towards the horizontal direction
+    /// `azimuth` (rad from x_0 about z_0).
+    Slope { angle: f64, azimuth: f64 },
+}
+
+impl TerrainSpec {
+    pub fn build(&self) -> Arc<dyn Terrain + Send + Sync> {
+        match *self {
+            TerrainSpec::Flat => Arc::new(FlatGround { height: 0.0 }),
+            TerrainSpec::Slope { angle, azimuth } => Arc::new(Slope::from_angle(0.0, angle, azimuth)),
+        }
+    }
+}
+
 /// Initial configuration (before settling), SI.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Initial {
@@ -205,6 +227,8 @@ pub struct Scenario {
     /// The text of the robot description (the embedded file for `"amru5"`).
     pub robot_text: String,
     pub model: ModelOptions,
+    /// The ground (`[model] terrain`).
+    pub terrain: TerrainSpec,
     pub plant: PlantOptions,
     pub initial: Initial,
     pub control: ControlMode,

@@ -24,6 +24,17 @@ use crate::control::{Command, Controller, DigitalPi, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
+/// Security margin of the AEP inside the workspace boundary (m).
+///
+/// INTERPRETATION: Section 7.1.1 restricts the working volume "for a degree of security"
+/// without a figure. The anchor of a new support is where the encoders put the foot seen from
+/// the estimated body pose, while its reference is computed from the desired pose (Eq. 7.11):
+/// the difference, the body's tracking error, moves the support foot reference. On the 20°
+/// slope that error reaches about 1 cm (and the horizontal joints' tracking error about 6 mm),
+/// and a foot landing on the boundary starts its support outside its workspace, lifts again at
+/// once (lowest margin, Rule 3) and keeps a neighbour at its boundary deadlocked. 1 cm.
+pub const AEP_SECURITY: f64 = 0.01;
+
 /// Parameters of the free gait.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FreeGaitOptions {
@@ -202,14 +213,15 @@ impl FreeGaitController {
     ///
     /// INTERPRETATION: the foot touches down after its landing, which carries it with the
     /// support motion for about the takeoff time; the AEP is set back by that distance,
-    /// |v_C| t_takeoff, so that the touchdown is on the boundary and not beyond it.
+    /// |v_C| t_takeoff, and by the security margin of the constrained working volume (Section
+    /// 7.1.1, [`AEP_SECURITY`]), so that the touchdown is inside the boundary and not beyond it.
     fn aep(&self, leg: usize, v_c: &Vector3<f64>, z: f64) -> Vector3<f64> {
         let w = &self.workspaces[leg];
         let v = Vector3::new(v_c.x, v_c.y, 0.0);
         let speed = v.norm();
         let mut aep = w.centre_at(z);
         if speed > 0.0 {
-            aep += v * ((w.radius - speed * self.options.takeoff_time).max(0.0) / speed);
+            aep += v * ((w.radius - speed * self.options.takeoff_time - AEP_SECURITY).max(0.0) / speed);
         }
         aep
     }
