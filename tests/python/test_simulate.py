@@ -42,6 +42,9 @@ SHIPPED = {
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 }
 
 

@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 22] = [
+const ALL: [&str; 25] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -63,6 +63,9 @@ const ALL: [&str; 22] = [
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 ];
 
 #[test]
