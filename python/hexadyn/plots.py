@@ -257,6 +257,30 @@ def trajectory_figure(results: Results) -> Figure:
     return fig
 
 
+def posture_figure(results: Results) -> Figure:
+    """The free gait's posture against the body's X (Fig. 7.33-7.41 style): above, the body
+    height above the ground plane the controller estimates from its contact points; below, the
+    roll and pitch of the body (simulated, and as the controller knows them), in degrees."""
+    ts = results.timeseries
+    if "body_clearance" not in ts.columns:
+        raise ValueError("posture: these results have no body_clearance column (not a free gait scenario)")
+    x = ts["X"].to_numpy() * 1e3
+    with style():
+        fig = Figure(figsize=(6.3, 4.4))
+        height, angles = fig.subplots(2, 1, sharex=True)
+        height.plot(x, ts["body_clearance"] * 1e3, color=SIMULATED, label="estimated ground plane")
+        height.set_ylabel("body height [mm]")
+        height.legend(loc="lower left", bbox_to_anchor=(0, 1.02), frameon=False, borderaxespad=0)
+        for name, colour in (("roll", SIMULATED), ("pitch", REFERENCE)):
+            angles.plot(x, np.degrees(ts[name]), color=colour, label=name)
+            angles.plot(x, np.degrees(ts[f"posture_{name}"]), color=colour, linestyle=":", label=f"{name} (controller)")
+        angles.set_xlabel("X [mm]")
+        angles.set_ylabel("angle [deg]")
+        angles.legend(loc="best", ncol=2, frameon=False)
+        fig.suptitle(f"{_title(results)}: posture against X")
+    return fig
+
+
 def averaged_power_figure(results: Results) -> Figure:
     """Averaged power per actuator (W), stacked by foot phase when the robot walks."""
     table = energy.averaged_power(results)
@@ -342,8 +366,8 @@ def _check_leg(leg: int) -> None:
 
 def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, Figure]:
     """The figures the results support, by file stem: ``leg0_q_r`` ... for the given legs, then
-    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``averaged_power`` and
-    ``energy_breakdown``."""
+    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``posture`` (free gait),
+    ``averaged_power`` and ``energy_breakdown``."""
     for leg in legs:
         _check_leg(leg)
     out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in JOINT_TYPES}
@@ -351,6 +375,8 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
         out["gait_diagram"] = gait_diagram(results)
     if "X_ref" in results.timeseries.columns:
         out["trajectory"] = trajectory_figure(results)
+    if "body_clearance" in results.timeseries.columns:
+        out["posture"] = posture_figure(results)
     out["averaged_power"] = averaged_power_figure(results)
     out["energy_breakdown"] = energy_breakdown_figure(results)
     if ground_detection.has_experiment(results):

@@ -51,6 +51,9 @@ SHIPPED = {
     "tripod_rough_ground",
     "tripod_low_step",
     "ground_detection",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 }
 
 

@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 31] = [
+const ALL: [&str; 34] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -72,6 +72,9 @@ const ALL: [&str; 31] = [
     "tripod_rough_ground",
     "tripod_low_step",
     "ground_detection",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 ];
 
 #[test]
@@ -604,12 +607,15 @@ fn gait_runs_record_the_walk_deterministically() {
 
 /// Issue 18: every shipped walk respects its workspaces from the first step: no foot
 /// reference clamped by the inverse kinematics, none more than 1 µm outside its workspace
-/// cylinder (the encoders' quantization of the start posture is below that).
+/// cylinder (the encoders' quantization of the start posture is below that). The periodic
+/// walks only: the free gait's feet leave the flat-ground cylinder's height range by design
+/// (posture, uneven ground), its horizontal boundary is kept by the deadlock rule (tested in
+/// `control::gait::free`).
 #[test]
 fn every_shipped_walk_keeps_its_feet_in_the_workspaces() {
     let mut walks: Vec<PathBuf> = std::fs::read_dir(scenarios_dir()).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
     walks.sort();
-    let walks: Vec<Scenario> = walks.iter().map(|p| Scenario::from_file(p).unwrap()).filter(|s| s.gait.is_some()).collect();
+    let walks: Vec<Scenario> = walks.iter().map(|p| Scenario::from_file(p).unwrap()).filter(|s| s.gait.as_ref().is_some_and(|g| g.free.is_none())).collect();
     assert!(walks.len() >= 14, "{} shipped walks", walks.len());
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     std::thread::scope(|scope| {

@@ -186,7 +186,7 @@ mod tests {
         use crate::control::Measurements;
         let motions = vec![(4, JointMotion::VoltageRamp { rate_v_per_s: 0.05 })];
         let mut c = JointPiController { pis: std::array::from_fn(|_| DigitalPi::new(500.0, 0.5, 0.01)), references: JointReferences { base: [0.05; JOINTS], motions } };
-        let m = Measurements { t: 10.0, positions: [0.04; JOINTS], currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None };
+        let m = Measurements { t: 10.0, positions: [0.04; JOINTS], currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
         let cmd = c.update(&m);
         assert_relative_eq!(cmd.voltages[4], 0.5, epsilon = 1e-12);
         assert_eq!(cmd.references[4], 0.04);

@@ -18,8 +18,12 @@
 //! | `X_ref`, `Y_ref`, `Z_ref`; `yaw_ref`, `pitch_ref`, `roll_ref` | m; rad | desired body pose T*_{0,b} (gait) |
 //! | `X_dot_ref`, `Y_dot_ref`; `omega_z_ref` | m/s; rad/s | commanded heading velocities (gait) |
 //! | `duty_factor` | 1 | β of the current gait pattern (gait) |
-//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing (gait) |
+//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing, 4 failed and held up (gait) |
 //! | `foot_ref_x[l]`, `foot_ref_y[l]`, `foot_ref_z[l]` | m | foot reference in the leg frame (gait) |
+//! | `body_clearance` | m | body height above the ground plane estimated from the contact points (free gait, Section 7.7.5) |
+//! | `posture_roll`, `posture_pitch` | rad | body roll and pitch as the free gait knows them (navigation, else desired) |
+//! | `touchdown[l]` | 1 | 1 when the landing of leg l was detected at t (free gait) |
+//! | `deadlock` | 1 | 1 while the support legs are halted (free gait, Section 7.7.4) |
 //! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
 //! | `i_q_v[i]` ... | A | motor current |
 //! | `i_meas_q_v[i]` ... | A | motor current as the controller measured it at t: through the analog 30 Hz filter, with the sensor noise (Section 5.6.2, [`crate::physics::CurrentSensors`]) |
@@ -144,7 +148,7 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
 }
 
 /// The gait controller's columns: desired body pose and velocities, duty factor, foot phases
-/// and foot references.
+/// and foot references; with the free gait its posture, detections and deadlock.
 pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
     let s = |x: &str| x.to_string();
     let pose = [g.pose.position.x, g.pose.position.y, g.pose.position.z, g.pose.angles.x, g.pose.angles.y, g.pose.angles.z];
@@ -155,14 +159,23 @@ pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
     rec.put(g.velocity.x, || (s("X_dot_ref"), "m/s", s("commanded heading velocity V_x (global)")));
     rec.put(g.velocity.y, || (s("Y_dot_ref"), "m/s", s("commanded heading velocity V_y (global)")));
     rec.put(g.omega.z, || (s("omega_z_ref"), "rad/s", s("commanded yaw rate Omega_z")));
-    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern")));
+    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern (NaN: free gait)")));
     for (l, phase) in g.phases.iter().enumerate() {
-        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing")));
+        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing, 4 failed (held up)")));
     }
     for (l, f) in g.feet.iter().enumerate() {
         rec.put(f.x, || (format!("foot_ref_x[{l}]"), "m", s("foot reference x, leg frame")));
         rec.put(f.y, || (format!("foot_ref_y[{l}]"), "m", s("foot reference y, leg frame")));
         rec.put(f.z, || (format!("foot_ref_z[{l}]"), "m", s("foot reference z, leg frame")));
+    }
+    if let Some(free) = &g.free {
+        rec.put(free.clearance, || (s("body_clearance"), "m", s("body height above the ground plane estimated from the contact points (free gait)")));
+        rec.put(free.roll, || (s("posture_roll"), "rad", s("body roll as the free gait knows it (navigation, else desired)")));
+        rec.put(free.pitch, || (s("posture_pitch"), "rad", s("body pitch as the free gait knows it (navigation, else desired)")));
+        for (l, t) in free.touchdowns.iter().enumerate() {
+            rec.put(f64::from(u8::from(*t)), || (format!("touchdown[{l}]"), "1", s("1 when the landing of the leg was detected at t (free gait)")));
+        }
+        rec.put(f64::from(u8::from(free.deadlock)), || (s("deadlock"), "1", s("1 while the support legs are halted by a deadlock (free gait, Section 7.7.4)")));
     }
 }
 

@@ -229,12 +229,15 @@ impl RobotModel {
         self.currents.map(|c| c + k)
     }
 
-    /// Initial q for the given joint positions: level body at (0, 0, Z), Z chosen so that the
-    /// lowest foot just touches the terrain (closest point: zero penetration); all other states
-    /// zero.
+    /// Initial q for the given joint positions: body at (0, 0, Z) with zero yaw, parallel to the
+    /// terrain below its origin (level on flat ground), Z chosen so that the lowest foot just
+    /// touches the terrain (closest point: zero penetration); all other states zero.
     pub fn touching_ground(&self, joints: &[f64; JOINTS]) -> Vec<f64> {
         let mut q = vec![0.0; self.coordinate_count()];
         q[6..DOF].copy_from_slice(joints);
+        // z_b = n: R_y(Θ) R_x(Ψ) e_z = (sin Θ cos Ψ, −sin Ψ, cos Θ cos Ψ) (Eq. 3.52 with Φ = 0).
+        let n = self.terrain.height_normal(0.0, 0.0).1;
+        (q[4], q[5]) = (n.x.atan2(n.z), (-n.y).asin());
         let mech = &self.mechanics;
         let mut data = Data::new(&mech.model);
         let mut clearance = |q: &[f64]| {

@@ -195,6 +195,7 @@ impl Plant for SimulatedRobot {
             currents: self.current_sensors.sample(),
             supply_voltage: self.robot.model.options.supply_voltage,
             pose: self.navigation.then(|| BodyPose { position: nalgebra::Vector3::new(q[0], q[1], q[2]), yaw: q[3], pitch: q[4], roll: q[5] }),
+            foot_normal_forces: Some(self.robot.outputs.contact.map(|c| c.normal_force)),
         }
     }
 

@@ -60,7 +60,7 @@ mod summary;
 mod terrain;
 
 pub use crate::control::gait::schedule::GaitChange;
-pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
+pub use gait::{FreeGaitSpec, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
@@ -96,7 +96,7 @@ pub enum ScenarioError {
     /// cause.
     #[error("{file}: {stage} failed: {source}{hint}")]
     Simulation { file: String, stage: &'static str, source: SimError, hint: &'static str },
-    /// The settled body tilts by more than 5°: the stance cannot carry it (it rests on lifted
+    /// The settled body tilts by more than 5° from the ground below it: the stance cannot carry it (it rests on lifted
     /// legs).
     #[error("{file}: settling tips the body over (pitch {pitch_deg:.1}°, roll {roll_deg:.1}°); check that the supporting feet surround the centre of mass (initial.lifted_legs)")]
     Tipped { file: String, pitch_deg: f64, roll_deg: f64 },

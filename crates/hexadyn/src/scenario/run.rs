@@ -94,6 +94,8 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
 pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
     let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), s.terrain.clone()));
     let mut q = model.touching_ground(&s.initial.joints);
+    // The attitude of the body parallel to the ground, which the settling should keep.
+    let (pitch0, roll0) = (q[4], q[5]);
     let mut qd = vec![0.0; q.len()];
     if s.initial.settle {
         let mut robot = Robot::new(model.clone());
@@ -104,7 +106,7 @@ pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
             source,
             hint: "; check that the supporting feet surround the centre of mass (initial.lifted_legs)",
         })?;
-        let (pitch, roll) = (q[4].to_degrees(), q[5].to_degrees());
+        let (pitch, roll) = ((q[4] - pitch0).to_degrees(), (q[5] - roll0).to_degrees());
         if pitch.abs() > 5.0 || roll.abs() > 5.0 {
             return Err(ScenarioError::Tipped { file: s.origin.clone(), pitch_deg: pitch, roll_deg: roll });
         }
@@ -128,7 +130,7 @@ pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Published) {
         ControlMode::Gait => {
             let g = s.gait.as_ref().expect("gait mode has a validated [gait]");
             let (controller, state) = g.controller(&s.robot);
-            (Box::new(controller), Published { gait: Some(state), ground: None })
+            (controller, Published { gait: Some(state), ground: None })
         }
         ControlMode::Pi => {
             let pis = joint_pis(&s.robot, s.plant.period);
