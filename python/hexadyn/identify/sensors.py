@@ -92,5 +92,6 @@ def measure(log: Log, sensors: SensorModel) -> Log:
                 step = joint_constants(log, joint, leg)["encoder_resolution"]
                 name = column("q", joint, leg)
                 frame[name] = np.round(frame[name].to_numpy() / step) * step
-    frame = pd.concat([frame, pd.DataFrame(added, index=frame.index)], axis=1)
+    # The sensors' readings replace those of a log that has some (the engine's own sensor model).
+    frame = pd.concat([frame.drop(columns=[c for c in added if c in frame.columns]), pd.DataFrame(added, index=frame.index)], axis=1)
     return Log(log.source, frame, log.robot_text, log.foot_load_kg, log.motions)
