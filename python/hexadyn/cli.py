@@ -7,6 +7,7 @@ Set ``HEXADYN_DEBUG=1`` to see the traceback of such an error.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import click
@@ -326,8 +327,17 @@ cli.add_command(view)
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the ``hexadyn`` console script."""
-    cli.main(args=argv, prog_name="hexadyn")
+    """Entry point of the ``hexadyn`` console script. After Ctrl-C (everything already cleaned
+    up and reported) the process ends at once, without the interpreter's teardown of pandas,
+    pyarrow and matplotlib, which takes seconds on a loaded machine."""
+    try:
+        cli.main(args=argv, prog_name="hexadyn")
+    except SystemExit as exc:
+        if exc.code != INTERRUPTED:
+            raise
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
 
 
 def _one_line(exc: BaseException) -> str:
