@@ -17,14 +17,16 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup chromium run test test-rust test-python bench bench-montecarlo lock clean
+.PHONY: help setup chromium run test test-rust test-python bench bench-peer bench-montecarlo terrains lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
 	@echo "make test   set everything up, then run the Rust and Python tests"
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
+	@echo "make bench-peer  the 75 s walk in hexadyn and in MuJoCo, timed in the same run"
 	@echo "make bench-montecarlo [MC_ARGS=\"--runs 50\"]  time a Monte Carlo campaign on every core (long)"
+	@echo "make terrains  regenerate the shipped terrain PLY files (python/hexadyn/scenarios/terrains)"
 	@echo "make lock   re-resolve requirements/lock.txt"
 	@echo "make clean  remove .venv and the Cargo target directory"
 
@@ -67,6 +69,17 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin gait
 	$(CARGO) run --release -p hexadyn-benches --bin walk
 	$(CARGO) run --release -p hexadyn-benches --bin link
+	$(CARGO) run --release -p hexadyn-benches --bin terrain
+
+# The shipped terrains are generated, never drawn: physics::terrain::generate, written as PLY.
+terrains:
+	$(CARGO) run --release -p hexadyn --example make_terrains -- python/hexadyn/scenarios/terrains
+
+# The peer benchmark against MuJoCo (installed here, from the lock, as the `bench` extra: not a
+# dependency of hexadyn or of its tests).
+bench-peer: setup
+	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) mujoco
+	$(PY) benches/peer_mujoco.py
 
 # Optional: the full campaign (1000 runs x 4 velocities x 2 variants) takes hours on a laptop.
 bench-montecarlo: setup
@@ -76,7 +89,7 @@ bench-montecarlo: setup
 lock:
 	rm -rf .lock-venv
 	$(PYTHON) -m venv .lock-venv
-	.lock-venv/bin/pip install --quiet maturin -e '.[test]'
+	.lock-venv/bin/pip install --quiet maturin -e '.[test,bench]'
 	{ sed -n '/^#/p' requirements/lock.txt; .lock-venv/bin/pip freeze --exclude-editable | grep -v '^hexadyn'; } > requirements/lock.txt.new
 	mv requirements/lock.txt.new requirements/lock.txt
 	rm -rf .lock-venv

@@ -155,6 +155,7 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
         )
     if report.in_memory(results):
         _echo_power(results)
+        _echo_ground_detection(results)
     else:
         click.echo(f"  analysis    skipped {s['analysis_skipped']}")
     if (out / "plots").is_dir():
@@ -182,6 +183,38 @@ def _echo_power(results: hexadyn.Results) -> None:
     block = table.loc[energy.ALL].rename(index=lambda leg: f"leg {leg}" if leg != energy.TOTAL else leg).rename_axis(index=None, columns=None)
     for line in block.to_string(float_format=lambda v: f"{v:7.3f}").splitlines():
         click.echo(f"    {line}")
+
+
+def _echo_ground_detection(results: hexadyn.Results) -> None:
+    """Table 5.7 of a ground detection run."""
+    from hexadyn import ground_detection
+
+    if not ground_detection.has_experiment(results):
+        return
+    stops = ground_detection.trials(results)
+    click.echo(f"  ground detection: {len(stops)} stops; true force at the stop (N) and error eps_F = (threshold - F) / threshold (%), Table 5.7:")
+    if not stops.empty:
+        for line in ground_detection.format_table(ground_detection.table(stops)).splitlines():
+            click.echo(f"    {line}")
+
+
+@cli.command("ground-detection")
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path))
+def ground_detection_table(folder: Path) -> None:
+    """Table 5.7 of the ground detection results FOLDER (a run of control mode
+    ground_detection, e.g. `hexadyn simulate ground_detection`): the true contact force at each
+    stop on a detection, per leg and threshold, with the mean and standard deviation of the
+    error; written to FOLDER/ground_detection.csv and FOLDER/ground_detection_table.csv."""
+    from hexadyn import atomic, ground_detection, report
+
+    results = hexadyn.Results.load(folder)
+    if not ground_detection.has_experiment(results):
+        raise click.ClickException(f"{folder}: not the results of a ground detection run (control.mode = \"ground_detection\"; no gd_stop column)")
+    stops = ground_detection.trials(results)
+    atomic.write_file(folder / ground_detection.TRIALS_FILE, lambda p: report.write_csv(p, stops.set_index(["leg", "threshold_n", "trial"])))
+    atomic.write_file(folder / ground_detection.TABLE_FILE, lambda p: report.write_csv(p, ground_detection.table(stops)))
+    _echo_ground_detection(results)
+    click.echo(f"Tables: {folder / ground_detection.TRIALS_FILE}, {folder / ground_detection.TABLE_FILE}")
 
 
 @cli.command()
@@ -279,10 +312,11 @@ def scenarios() -> None:
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
 @click.option("--variants", default=None, help="Comma-separated friction variants (default: dry_viscous,dry_viscous_load).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
+@click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
 @click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_address, no_progress) -> None:
+def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, workers, ray_address, no_progress) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
     Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm) for every friction
@@ -307,6 +341,7 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, workers, ray_add
         runs_per_velocity=runs,
         variants=listed("--variants", variants, str.strip),
         seed=seed,
+        friction_stats=friction_stats,
     )
     try:
         table = campaign.run(out, workers=workers, ray=ray_address, progress=not no_progress)
@@ -350,6 +385,10 @@ def _one_line(exc: BaseException) -> str:
 from hexadyn.link.cli import robot  # noqa: E402  (the `hexadyn robot` commands)
 
 cli.add_command(robot)
+
+from hexadyn.identify.command import identify_command  # noqa: E402  (hexadyn identify: Chapter 5)
+
+cli.add_command(identify_command)
 
 if __name__ == "__main__":  # pragma: no cover
     main()

@@ -12,7 +12,10 @@ backends. Figures display in Jupyter as they are.
 - :func:`averaged_power_figure`: averaged power per actuator split by foot phase
   (Tables 6.3-6.6 as a chart);
 - :func:`energy_breakdown_figure`: electrical energy of each actuator split into Joule losses,
-  friction work and mechanical work.
+  friction work and mechanical work;
+- :func:`ground_detection_figure`: the ground detection experiment (Section 5.6.3): estimated
+  and true ground force of a tested leg around its first stop, with its vertical joint
+  (Fig. 5.17).
 
 :func:`figures` builds those the results support (the gait diagram and the trajectory need a
 walking scenario) and :func:`save_figures` writes them as 300 dpi PNG and, on request, vector
@@ -31,7 +34,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
-from hexadyn import energy
+from hexadyn import energy, ground_detection
 from hexadyn.vocabulary import JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
@@ -85,6 +88,7 @@ __all__ = [
     "energy_breakdown_figure",
     "figures",
     "gait_diagram",
+    "ground_detection_figure",
     "joint_figure",
     "parse_legs",
     "save_figures",
@@ -253,6 +257,30 @@ def trajectory_figure(results: Results) -> Figure:
     return fig
 
 
+def posture_figure(results: Results) -> Figure:
+    """The free gait's posture against the body's X (Fig. 7.33-7.41 style): above, the body
+    height above the ground plane the controller estimates from its contact points; below, the
+    roll and pitch of the body (simulated, and as the controller knows them), in degrees."""
+    ts = results.timeseries
+    if "body_clearance" not in ts.columns:
+        raise ValueError("posture: these results have no body_clearance column (not a free gait scenario)")
+    x = ts["X"].to_numpy() * 1e3
+    with style():
+        fig = Figure(figsize=(6.3, 4.4))
+        height, angles = fig.subplots(2, 1, sharex=True)
+        height.plot(x, ts["body_clearance"] * 1e3, color=SIMULATED, label="estimated ground plane")
+        height.set_ylabel("body height [mm]")
+        height.legend(loc="lower left", bbox_to_anchor=(0, 1.02), frameon=False, borderaxespad=0)
+        for name, colour in (("roll", SIMULATED), ("pitch", REFERENCE)):
+            angles.plot(x, np.degrees(ts[name]), color=colour, label=name)
+            angles.plot(x, np.degrees(ts[f"posture_{name}"]), color=colour, linestyle=":", label=f"{name} (controller)")
+        angles.set_xlabel("X [mm]")
+        angles.set_ylabel("angle [deg]")
+        angles.legend(loc="best", ncol=2, frameon=False)
+        fig.suptitle(f"{_title(results)}: posture against X")
+    return fig
+
+
 def averaged_power_figure(results: Results) -> Figure:
     """Averaged power per actuator (W), stacked by foot phase when the robot walks."""
     table = energy.averaged_power(results)
@@ -338,8 +366,8 @@ def _check_leg(leg: int) -> None:
 
 def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, Figure]:
     """The figures the results support, by file stem: ``leg0_q_r`` ... for the given legs, then
-    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``averaged_power`` and
-    ``energy_breakdown``."""
+    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``posture`` (free gait),
+    ``averaged_power`` and ``energy_breakdown``."""
     for leg in legs:
         _check_leg(leg)
     out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in JOINT_TYPES}
@@ -347,9 +375,48 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
         out["gait_diagram"] = gait_diagram(results)
     if "X_ref" in results.timeseries.columns:
         out["trajectory"] = trajectory_figure(results)
+    if "body_clearance" in results.timeseries.columns:
+        out["posture"] = posture_figure(results)
     out["averaged_power"] = averaged_power_figure(results)
     out["energy_breakdown"] = energy_breakdown_figure(results)
+    if ground_detection.has_experiment(results):
+        out["ground_detection"] = ground_detection_figure(results)
     return out
+
+
+def ground_detection_figure(results: Results, leg: int | None = None) -> Figure:
+    """Fig. 5.17: the ground force F_z,gnd estimated from the motor current (Eq. 5.22) and the
+    simulated normal force on the foot, from 3 s before to 5 s after the first stop of ``leg``
+    (default: the first leg that stopped), the threshold dashed; below, the vertical joint q_v
+    and its reference (the reference is held at the stop, then the sawtooth resumes)."""
+    trials = ground_detection.trials(results)
+    if trials.empty:
+        raise ValueError("no stop on a detection in these results")
+    leg = int(trials["leg"].iloc[0]) if leg is None else leg
+    _check_leg(leg)
+    first = trials[trials["leg"] == leg]
+    if first.empty:
+        raise ValueError(f"leg {leg} never stopped on a detection; legs that did: {sorted(set(trials['leg']))}")
+    t0, threshold = float(first["t_s"].iloc[0]), float(first["threshold_n"].iloc[0])
+    ts = results.timeseries.loc[t0 - 3.0 : t0 + 5.0]
+    t = ts.index.to_numpy()
+    with style():
+        fig = Figure(figsize=(6.3, 4.2))
+        top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
+        top.plot(t, ts[f"F_gnd_est[{leg}]"], color=SIMULATED, label="estimated $F_{z,gnd}$ (Eq. 5.22)")
+        top.plot(t, ts[leg_column("Fn", leg)], color="#c0392b", label="true normal force")
+        top.axhline(threshold, color=REFERENCE, linestyle="--", label=f"threshold {threshold:g} N")
+        top.axvline(t0, color="0.6", linewidth=0.6)
+        top.set_ylabel("ground force [N]")
+        top.legend(loc="upper left", frameon=False)
+        bottom.plot(t, ts[leg_column("q_v", leg)] * 1e3, color=SIMULATED, label="$q_v$")
+        bottom.plot(t, ts[leg_column("q_v_ref", leg)] * 1e3, color=REFERENCE, linestyle="--", label="reference")
+        bottom.set_ylabel("$q_v$ [mm]")
+        bottom.set_xlabel("time [s]")
+        bottom.legend(loc="upper left", frameon=False)
+        bottom.set_xlim(t[0], t[-1])
+        fig.suptitle(f"{_title(results)}: ground detection, leg {leg}")
+    return fig
 
 
 def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS) -> list[Path]:

@@ -11,6 +11,8 @@ The folder holds the files of :class:`~hexadyn.results.Results` (``timeseries.pa
 - ``power.csv``: averaged power per leg and joint type, split by foot phase
   (:func:`hexadyn.energy.averaged_power`, Tables 6.3-6.6);
 - ``energy.csv``: energy breakdown per actuator (:func:`hexadyn.energy.energy_breakdown`);
+- ``ground_detection.csv`` and ``ground_detection_table.csv`` (runs of control mode
+  ``ground_detection``): the stops and Table 5.7 (:mod:`hexadyn.ground_detection`);
 - ``plots/`` (on request): the figures of :func:`hexadyn.plots.figures`.
 
 This module is the top of the analysis layers (results -> energy -> plots -> report).
@@ -25,7 +27,7 @@ from typing import Callable, Mapping, Sequence
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hexadyn import atomic, energy
+from hexadyn import atomic, energy, ground_detection
 from hexadyn import plots as plotting
 from hexadyn.results import IN_MEMORY_LIMIT_BYTES, Results
 
@@ -90,6 +92,10 @@ def save_run(
         if small:
             write_csv(tmp / POWER_FILE, energy.averaged_power(results))
         write_csv(tmp / ENERGY_FILE, energy.energy_breakdown(results))
+        if small and ground_detection.has_experiment(results):
+            stops = ground_detection.trials(results)
+            write_csv(tmp / ground_detection.TRIALS_FILE, stops.set_index(["leg", "threshold_n", "trial"]))
+            write_csv(tmp / ground_detection.TABLE_FILE, ground_detection.table(stops))
         if plots and small:
             (tmp / PLOTS_DIR).mkdir()
             _save_figures(figures if figures is not None else _figures(results, legs), tmp / PLOTS_DIR, formats)

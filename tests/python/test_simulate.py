@@ -42,6 +42,18 @@ SHIPPED = {
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "identification_q_r",
+    "identification_q_v",
+    "identification_q_h",
+    "identification_breakaway_plus",
+    "identification_breakaway_minus",
+    "identification_loaded_q_h",
+    "tripod_rough_ground",
+    "tripod_low_step",
+    "ground_detection",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 }
 
 

@@ -2,6 +2,7 @@
 
 use pyo3::prelude::*;
 
+mod leg;
 mod link;
 mod mbs;
 mod monte_carlo;
@@ -17,9 +18,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::scenario_model, m)?)?;
+    m.add_function(wrap_pyfunction!(scenario::terrain_triangles, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
     schema::register(m)?;
     m.add_class::<view::PyKinematics>()?;
+    m.add_class::<leg::PyLegModel>()?;
     m.add_function(wrap_pyfunction!(link::encode_command, m)?)?;
     m.add_function(wrap_pyfunction!(link::decode_command, m)?)?;
     m.add_function(wrap_pyfunction!(link::encode_reply, m)?)?;

@@ -9,7 +9,8 @@ use std::sync::Mutex;
 
 use hexadyn::robot::recorder::TimeSeries;
 use hexadyn::scenario::{run_scenario_chunked, run_scenario_until, HeadingSpec, ModelFlags, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
-use numpy::PyArray1;
+use hexadyn::physics::Extent;
+use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -273,4 +274,29 @@ fn flags_dict(py: Python<'_>, flags: ModelFlags) -> PyResult<Bound<'_, PyDict>> 
 #[pyfunction]
 pub fn scenario_model<'py>(py: Python<'py>, text: &str, origin: &str) -> PyResult<Bound<'py, PyDict>> {
     flags_dict(py, Scenario::model_flags(text, origin).map_err(value_error)?)
+}
+
+/// The ground of a scenario as triangles, for drawing: `(vertices, faces)`, numpy arrays of
+/// shape (n, 3) (m, float64) and (m, 3) (vertex indices, uint32, counter-clockwise seen from
+/// above). A mesh or heightfield gives its own triangles; a plane or a step the square of side
+/// 2 `half_width_m` around (`centre_x_m`, `centre_y_m`). Raises ValueError on an invalid
+/// scenario.
+#[pyfunction]
+#[pyo3(signature = (path, overrides = None, half_width_m = 5.0, centre_x_m = 0.0, centre_y_m = 0.0))]
+pub fn terrain_triangles<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    overrides: Option<Bound<'py, PyDict>>,
+    half_width_m: f64,
+    centre_x_m: f64,
+    centre_y_m: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+    if !(half_width_m.is_finite() && half_width_m > 0.0 && centre_x_m.is_finite() && centre_y_m.is_finite()) {
+        return Err(PyValueError::new_err(format!("terrain_triangles: half_width_m = {half_width_m}, centre = ({centre_x_m}, {centre_y_m}); allowed: a finite half width > 0 and a finite centre (m)")));
+    }
+    let s = load(&path, overrides.as_ref())?;
+    let t = s.terrain.triangles(Extent { centre: [centre_x_m, centre_y_m], half_width: half_width_m });
+    let vertices = PyArray2::from_vec2(py, &t.vertices.iter().map(|v| v.to_vec()).collect::<Vec<_>>())?;
+    let faces = PyArray2::from_vec2(py, &t.faces.iter().map(|f| f.to_vec()).collect::<Vec<_>>())?;
+    Ok((vertices, faces))
 }

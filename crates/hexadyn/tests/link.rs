@@ -4,11 +4,14 @@
 //! asserts on time: the timing figures are in the `link` benchmark. The machine running the
 //! tests is shared, so its scheduling hiccups can make a packet late now and then: except in
 //! the test of the 3-period safety stop itself, the master tolerates 10 missing periods in a
-//! row, and every test lets a command be up to 5 ms late before calling it an overrun, so that
-//! only the faults under test decide the outcome.
+//! row, and every test lets a command be up to 100 ms late before calling it an overrun (a
+//! loaded machine was seen to deschedule the master for 19 ms), so that only the faults under
+//! test decide the outcome. The linked runs take turns (`ONE_LINK_AT_A_TIME`):
+//! two real-time walks sharing the test machine's two cores would make each other late.
 
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::time::Duration;
 
 use hexadyn::control::Encoder;
@@ -22,6 +25,9 @@ use hexadyn::scenario::{run_scenario, Override, Scenario};
 /// Missing periods tolerated by the tests that are not about the safety stop.
 const TOLERANT: u32 = 10;
 
+/// Held by every linked run of this file (the test harness runs tests on parallel threads).
+static ONE_LINK_AT_A_TIME: Mutex<()> = Mutex::new(());
+
 fn scenario(name: &str, duration_s: f64) -> Scenario {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios").join(format!("{name}.toml"));
     Scenario::from_file_with(path, &[Override { field: "scenario.duration_s".into(), value: toml::Value::Float(duration_s) }]).expect("shipped scenario")
@@ -30,9 +36,10 @@ fn scenario(name: &str, duration_s: f64) -> Scenario {
 /// Runs `s` through the master against the emulator on loopback; the master stops the robot
 /// after `missing_periods` periods without a packet of a slave.
 fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRun, LinkError>, EmulatorReport) {
+    let _turn = ONE_LINK_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let mut config = LinkConfig::loopback(0);
     config.safety.missing_periods = missing_periods;
-    config.safety.overrun_tolerance = Duration::from_millis(5);
+    config.safety.overrun_tolerance = Duration::from_millis(100);
     // Real-time threads where permitted: the machine running the tests is shared.
     config.timing.realtime_priority = Some(40);
     let options = EmulatorOptions { faults, idle_timeout: Some(Duration::from_secs(5)), history: true };

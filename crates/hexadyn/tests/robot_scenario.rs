@@ -40,7 +40,7 @@ fn field_error(text: &str, field: &str) -> String {
     s
 }
 
-const ALL: [&str; 22] = [
+const ALL: [&str; 34] = [
     "stand_six_legs",
     "stand_three_legs",
     "unpowered_none",
@@ -63,13 +63,26 @@ const ALL: [&str; 22] = [
     "soft_ground_enhanced",
     "soft_ground_plain",
     "gait_changes",
+    "identification_q_r",
+    "identification_q_v",
+    "identification_q_h",
+    "identification_breakaway_plus",
+    "identification_breakaway_minus",
+    "identification_loaded_q_h",
+    "tripod_rough_ground",
+    "tripod_low_step",
+    "ground_detection",
+    "free_gait_straight",
+    "free_gait_slope_square",
+    "free_gait_five_legs",
 ];
 
 #[test]
 fn shipped_scenarios_are_valid() {
     let mut found: Vec<String> = std::fs::read_dir(scenarios_dir())
         .unwrap()
-        .filter_map(|e| e.ok()?.path().file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .filter_map(|e| Some(e.ok()?.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")))
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
         .collect();
     found.sort();
     let mut expected: Vec<String> = ALL.iter().map(|s| s.to_string()).collect();
@@ -594,12 +607,15 @@ fn gait_runs_record_the_walk_deterministically() {
 
 /// Issue 18: every shipped walk respects its workspaces from the first step: no foot
 /// reference clamped by the inverse kinematics, none more than 1 µm outside its workspace
-/// cylinder (the encoders' quantization of the start posture is below that).
+/// cylinder (the encoders' quantization of the start posture is below that). The periodic
+/// walks only: the free gait's feet leave the flat-ground cylinder's height range by design
+/// (posture, uneven ground), its horizontal boundary is kept by the deadlock rule (tested in
+/// `control::gait::free`).
 #[test]
 fn every_shipped_walk_keeps_its_feet_in_the_workspaces() {
     let mut walks: Vec<PathBuf> = std::fs::read_dir(scenarios_dir()).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "toml")).collect();
     walks.sort();
-    let walks: Vec<Scenario> = walks.iter().map(|p| Scenario::from_file(p).unwrap()).filter(|s| s.gait.is_some()).collect();
+    let walks: Vec<Scenario> = walks.iter().map(|p| Scenario::from_file(p).unwrap()).filter(|s| s.gait.as_ref().is_some_and(|g| g.free.is_none())).collect();
     assert!(walks.len() >= 14, "{} shipped walks", walks.len());
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     std::thread::scope(|scope| {

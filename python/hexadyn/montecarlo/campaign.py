@@ -26,7 +26,7 @@ from typing import Any, Callable, Iterable, Sequence, Union
 
 from hexadyn._core import __version__
 from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
-from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction
+from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction, read_friction_stats
 from hexadyn.montecarlo.storage import CampaignStore, RunKey
 from hexadyn.montecarlo.tables import plot_specific_resistance, specific_resistance_table, write_table
 from hexadyn.runner import resolve_scenario
@@ -66,9 +66,12 @@ class Campaign:
         runs_per_velocity: int | None = None,
         variants: Sequence[str] | None = None,
         seed: int = 0,
+        friction_stats: str | os.PathLike | None = None,
     ) -> Campaign:
         """Validates a campaign; ``None`` takes the robot's ``[monte_carlo]`` defaults (all
-        variants for ``variants``). Raises ValueError (one line) for bad input."""
+        variants for ``variants``). `friction_stats`: a file written by ``hexadyn identify``
+        whose Gaussians replace the robot's (Table 6.7). Raises ValueError (one line) for bad
+        input."""
         from hexadyn import _core
 
         path = resolve_scenario(scenario)
@@ -76,6 +79,8 @@ class Campaign:
         if info["gait"] is None:
             raise ValueError(f"{path}: a Monte Carlo campaign needs a walking scenario (control.mode = \"gait\"), for the specific resistance")
         distributions = FrictionDistributions.of_robot(info["robot"])
+        if friction_stats is not None:
+            distributions = distributions.with_stats(read_friction_stats(friction_stats), os.fspath(friction_stats))
         for field in distributions.gaussians:
             distributions.accepted_interval(field)
         runs = distributions.runs_per_velocity if runs_per_velocity is None else runs_per_velocity

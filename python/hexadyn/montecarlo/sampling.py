@@ -13,12 +13,16 @@ of a run use the same draw (common random numbers).
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
+import tomllib
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FrictionDistributions", "draw_friction"]
+__all__ = ["FrictionDistributions", "draw_friction", "read_friction_stats"]
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,17 @@ class FrictionDistributions:
             fixed={k: float(v) for k, v in d["fixed"].items()},
         )
 
+    def with_stats(self, stats: dict[str, tuple[float, float]], source: str) -> FrictionDistributions:
+        """The same set-up with the Gaussians of `stats` (scenario field -> (mu, sigma), e.g.
+        identified by ``hexadyn identify``) in place of the robot's. Fields the robot's set-up
+        holds fixed (the horizontal viscous slopes, neglected in Section 6.5) are left fixed;
+        any other field not drawn is an error naming `source`."""
+        unknown = [f for f in stats if f not in self.gaussians and f not in self.fixed]
+        if unknown:
+            raise ValueError(f"{source}: {', '.join(unknown)}: not a friction parameter of the Monte Carlo runs; allowed: {', '.join(self.gaussians)}")
+        gaussians = {f: stats.get(f, g) for f, g in self.gaussians.items()}
+        return dataclasses.replace(self, gaussians=gaussians)
+
     def accepted_interval(self, field: str) -> tuple[float, float]:
         """The values a draw of ``field`` keeps: mu +- truncation_sigmas sigma, physical ones.
 
@@ -93,3 +108,27 @@ def draw_friction(distributions: FrictionDistributions, seed: int, velocity_inde
             x = mu + sigma * float(rng.standard_normal())
         drawn[field] = x
     return drawn
+
+
+def read_friction_stats(path: str | os.PathLike) -> dict[str, tuple[float, float]]:
+    """The ``[friction_stats]`` table of a file written by ``hexadyn identify``
+    (``friction_stats.toml``): scenario field -> (mu, sigma), sigma >= 0, both finite.
+
+    Raises:
+        ValueError: naming the file, the field and the value.
+    """
+    path = Path(path)
+    try:
+        table = tomllib.loads(path.read_text(encoding="utf-8")).get("friction_stats")
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read the friction statistics: {exc}") from exc
+    if not isinstance(table, dict) or not table:
+        raise ValueError(f"{path}: no [friction_stats] table (the file `hexadyn identify` writes as friction_stats.toml)")
+    stats = {}
+    for field, entry in table.items():
+        mu, sigma = (entry.get("mu"), entry.get("sigma")) if isinstance(entry, dict) else (None, None)
+        ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in (mu, sigma))
+        if not ok or sigma < 0:
+            raise ValueError(f"{path}: field `friction_stats.\"{field}\"` = {entry!r}: need {{ mu = finite, sigma = finite >= 0 }}")
+        stats[field] = (float(mu), float(sigma))
+    return stats

@@ -162,6 +162,24 @@ class Run:
         """The body position (N, 3) of every recorded instant."""
         return self.q[:, :3]
 
+    def terrain(self, centre: np.ndarray, half_width: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The ground of the run's scenario file (``scenario_path``) as vertices (float32) and
+        faces, when it is not flat: None for flat ground, or when the file is gone or invalid
+        (the flat marks are drawn then). Planes and steps are cut to the square around
+        ``centre`` (x, y) of half side ``half_width``."""
+        from hexadyn import _core
+
+        path = self.metadata.get("scenario_path")
+        if not path or not Path(path).is_file():
+            return None
+        try:
+            vertices, faces = _core.terrain_triangles(str(path), half_width_m=float(half_width), centre_x_m=float(centre[0]), centre_y_m=float(centre[1]))
+        except ValueError:
+            return None
+        if np.ptp(vertices[:, 2]) == 0.0:
+            return None
+        return vertices.astype(np.float32), faces
+
     def footholds(self) -> np.ndarray:
         """Where the feet touched down (K, 3): the recorded foot positions at each start of a
         support phase (phase 0), or of a contact (F_z > 0) in runs without a gait."""

@@ -23,6 +23,7 @@ LINK_COLOURS = ((205, 160, 60), (150, 150, 150), (150, 150, 150), (215, 120, 40)
 PHASE_COLOURS = {0: (30, 30, 30), 1: (240, 170, 0), 2: (230, 60, 40), 3: (40, 150, 230), -1: (30, 30, 30)}
 PATH_COLOUR = (20, 50, 200)
 GRID_COLOUR = (150, 150, 150)
+TERRAIN_COLOUR = (185, 170, 140)
 REFERENCE_COLOUR = (130, 210, 130)
 FOOTHOLD_COLOUR = (120, 60, 160)
 FORCE_COLOUR = (220, 30, 120)
@@ -166,6 +167,10 @@ class RobotScene:
         crosses = [np.array([c - arm, c + arm]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
         crosses += [np.array([c - arm[::-1], c + arm[::-1]]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
         scene.add_mesh_simple("/terrain", *_ribbons(crosses, 0.004, 0.0), color=GRID_COLOUR, cast_shadow=False, side="double")
+        # A ground that is not flat (a step, a slope, a mesh): its triangles, under the marks.
+        surface = run.terrain((lo + hi) / 2, float(np.max(hi - lo)) / 2)
+        if surface is not None:
+            scene.add_mesh_simple("/terrain/surface", *surface, color=TERRAIN_COLOUR, cast_shadow=False, side="double")
         if len(keep) > 1:
             scene.add_mesh_simple("/paths/body", *_ribbons([path[keep, :2]], 0.01, 0.003), color=PATH_COLOUR, cast_shadow=False, side="double")
         if run.reference_xy is not None and len(keep) > 1:

@@ -1,7 +1,7 @@
 //! The controller interface (thesis Section 2.3.2 and architecture principle 3): every control
 //! period the controller receives what the real robot measures — encoder positions, motor
-//! currents, the supply voltage — plus the body pose when a navigation system is present, and
-//! returns the 18 motor voltages. A [`Plant`] is what is driven: the simulated robot, or the real
+//! currents, the supply voltage — plus the body pose when a navigation system is present (and, in
+//! simulation only, the true foot normal forces), and returns the 18 motor voltages. A [`Plant`] is what is driven: the simulated robot, or the real
 //! robot's slave boards through the master/slave link.
 
 use nalgebra::Vector3;
@@ -30,6 +30,11 @@ pub struct Measurements {
     pub supply_voltage: f64,
     /// True body pose, when the scenario has a navigation system.
     pub pose: Option<BodyPose>,
+    /// True normal ground force on each foot (N), filled by the simulated plant only: the real
+    /// robot has no foot force sensors (it detects the ground from its motor currents, Section
+    /// 5.6). The free gait's landing detection "force" reads it, the simulation mode of
+    /// Section 7.7 (ground detected above 10 N).
+    pub foot_normal_forces: Option<[f64; 6]>,
 }
 
 /// What the controller returns: the motor voltages and, for the record, the joint references

@@ -19,6 +19,10 @@ pub fn joint_pis(robot: &RobotDescription, dt: f64) -> [DigitalPi; JOINTS] {
 /// Joint references q_d(t).
 pub trait ReferenceSource {
     fn reference(&mut self, t: f64) -> [f64; JOINTS];
+    /// The voltage of joint k at t if it is driven open loop instead of by its PI.
+    fn open_loop_voltage(&self, _k: usize, _t: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// The motion of one joint reference about its base position.
@@ -32,6 +36,25 @@ pub enum JointMotion {
     /// Back and forth between `min` and `max` at constant speed, starting at the base position
     /// going up (the identification profiles of Section 5.2, Table 5.2).
     Sawtooth { min: f64, max: f64, speed: f64 },
+    /// The sawtooth of the identification campaign (Table 5.2): one back-and-forth cycle at
+    /// `speed`, the next at `speed + speed_step`, and so on up to `speed_max`, which the last
+    /// cycles keep. A cycle starts and ends at `min`; the first starts at the base going up.
+    SawtoothSteps { min: f64, max: f64, speed: f64, speed_step: f64, speed_max: f64 },
+    /// Open loop: the motor voltage rises as `rate_v_per_s` t and the joint's PI is bypassed
+    /// (the breakaway experiment of Section 5.3, 0.05 V/s); the reference is the base.
+    VoltageRamp { rate_v_per_s: f64 },
+}
+
+/// Position on a sawtooth between `min` and `max` at `speed`, `s` seconds after leaving `min`
+/// going up (one cycle lasts 2 (max − min) / speed).
+fn sawtooth_at(min: f64, max: f64, speed: f64, s: f64) -> f64 {
+    let span = max - min;
+    let s = s.rem_euclid(2.0 * span / speed);
+    if s * speed <= span {
+        min + s * speed
+    } else {
+        max - (s * speed - span)
+    }
 }
 
 impl JointMotion {
@@ -39,17 +62,27 @@ impl JointMotion {
         match *self {
             JointMotion::Ramp { rate, start_s, stop_s } => base + rate * (t.clamp(start_s, stop_s) - start_s),
             JointMotion::Sine { amplitude, frequency_hz } => base + amplitude * (TAU * frequency_hz * t).sin(),
-            JointMotion::Sawtooth { min, max, speed } => {
-                let span = max - min;
-                let period = 2.0 * span / speed;
-                // Phase so that t = 0 is at `base`, moving up.
-                let s = ((base - min) / speed + t).rem_euclid(period);
-                if s * speed <= span {
-                    min + s * speed
-                } else {
-                    max - (s * speed - span)
+            // Phase so that t = 0 is at `base`, moving up.
+            JointMotion::Sawtooth { min, max, speed } => sawtooth_at(min, max, speed, (base - min) / speed + t),
+            JointMotion::SawtoothSteps { min, max, speed, speed_step, speed_max } => {
+                let mut s = (base - min) / speed + t;
+                let mut v = speed;
+                // Whole cycles at the increasing speeds, then the last speed for ever.
+                while v < speed_max && s >= 2.0 * (max - min) / v {
+                    s -= 2.0 * (max - min) / v;
+                    v = (v + speed_step).min(speed_max);
                 }
+                sawtooth_at(min, max, v, s)
             }
+            JointMotion::VoltageRamp { .. } => base,
+        }
+    }
+
+    /// The open-loop voltage at t of a [`JointMotion::VoltageRamp`], None for a position motion.
+    pub fn open_loop_voltage(&self, t: f64) -> Option<f64> {
+        match *self {
+            JointMotion::VoltageRamp { rate_v_per_s } => Some(rate_v_per_s * t),
+            _ => None,
         }
     }
 }
@@ -69,6 +102,9 @@ impl ReferenceSource for JointReferences {
         }
         r
     }
+    fn open_loop_voltage(&self, k: usize, t: f64) -> Option<f64> {
+        self.motions.iter().find(|(j, _)| *j == k).and_then(|(_, m)| m.open_loop_voltage(t))
+    }
 }
 
 /// 18 digital PI position loops with antiwindup at the supply voltage (Section 4.4.5).
@@ -79,8 +115,14 @@ pub struct JointPiController<R: ReferenceSource> {
 
 impl<R: ReferenceSource> Controller for JointPiController<R> {
     fn update(&mut self, m: &Measurements) -> Command {
-        let references = self.references.reference(m.t);
-        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
+        let mut references = self.references.reference(m.t);
+        let voltages = std::array::from_fn(|k| match self.references.open_loop_voltage(k, m.t) {
+            Some(u) => {
+                references[k] = m.positions[k];
+                u.clamp(-m.supply_voltage, m.supply_voltage)
+            }
+            None => self.pis[k].update(references[k] - m.positions[k], m.supply_voltage),
+        });
         Command { voltages, references }
     }
 }
@@ -121,6 +163,35 @@ mod tests {
         }
         // Period 2 span / speed.
         assert_relative_eq!(m.value(0.05, 3.3), m.value(0.05, 3.3 + 2.0 * 0.035 / 0.008), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn sawtooth_steps_raise_the_speed_every_cycle() {
+        // Table 5.2 for q_v: 0.5 to 8 mm/s by 0.5 mm/s over [0.04, 0.075] m.
+        let m = JointMotion::SawtoothSteps { min: 0.04, max: 0.075, speed: 0.0005, speed_step: 0.0005, speed_max: 0.008 };
+        let cycle = |v: f64| 2.0 * 0.035 / v;
+        assert_relative_eq!(m.value(0.04, 1.0), 0.0405, epsilon = 1e-12);
+        // Second cycle at 1 mm/s: 1 s after its start the reference has risen 1 mm.
+        let t1 = cycle(0.0005);
+        assert_relative_eq!(m.value(0.04, t1 + 1.0), 0.041, epsilon = 1e-12);
+        // After the 16 increasing cycles the speed stays at 8 mm/s.
+        let t16: f64 = (1..=16).map(|k| cycle(0.0005 * k as f64)).sum();
+        assert_relative_eq!(m.value(0.04, t16 - 1.0), 0.04 + 0.008, epsilon = 1e-9);
+        assert_relative_eq!(m.value(0.04, t16 + 1.0), 0.04 + 0.008, epsilon = 1e-9);
+        assert_relative_eq!(m.value(0.04, t16 + cycle(0.008) + 2.0), 0.04 + 0.016, epsilon = 1e-9);
+    }
+
+    #[test]
+    fn voltage_ramp_bypasses_the_pi() {
+        use crate::control::Measurements;
+        let motions = vec![(4, JointMotion::VoltageRamp { rate_v_per_s: 0.05 })];
+        let mut c = JointPiController { pis: std::array::from_fn(|_| DigitalPi::new(500.0, 0.5, 0.01)), references: JointReferences { base: [0.05; JOINTS], motions } };
+        let m = Measurements { t: 10.0, positions: [0.04; JOINTS], currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
+        let cmd = c.update(&m);
+        assert_relative_eq!(cmd.voltages[4], 0.5, epsilon = 1e-12);
+        assert_eq!(cmd.references[4], 0.04);
+        // The other joints are still held by their PI (error 0.01 m -> a positive voltage).
+        assert!(cmd.voltages[5] > 0.0);
     }
 
     #[test]

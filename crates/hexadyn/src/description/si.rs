@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
 use crate::hexapod::{Joint, LEG_COUNT};
-use crate::physics::LoadDependence;
+use crate::physics::{DryViscous, LoadDependence};
 
 impl MotorTable {
     /// L in H.
@@ -80,6 +80,11 @@ pub struct JointFrictionParameters {
 }
 
 impl JointFrictionParameters {
+    /// The dry/viscous law of Eq. 6.1 with these parameters (unloaded dry friction).
+    pub fn dry_viscous(&self) -> DryViscous {
+        DryViscous { tau_f_d_plus: self.tau_f_d_plus, tau_f_d_minus: self.tau_f_d_minus, f_v_plus: self.f_v_plus, f_v_minus: self.f_v_minus, epsilon: self.epsilon }
+    }
+
     /// Dry friction under a foot load of `load_kg` (Eq. 5.12 with a_0 the unloaded dry
     /// friction, Section 6.4.4), as (tilde_tau_f_d^+, tilde_tau_f_d^-). Joints without a load
     /// dependence return the unloaded values.

@@ -12,11 +12,13 @@
 //! assert_eq!(joint_index(5, 2), DOF - 1);
 //! ```
 
+pub mod leg_dynamics;
 pub mod leg_kinematics;
 pub mod mechanics;
 pub mod pantograph;
 pub mod workspace;
 
+pub use leg_dynamics::leg_joint_torques;
 pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegKinematics, LegKinematicsError, Limit};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::PantographGeometry;

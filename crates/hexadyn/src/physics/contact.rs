@@ -1,54 +1,16 @@
 //! Compliant foot-ground contact (thesis Section 3.4.2, Eq. 3.72-3.74, Table 3.3).
 //!
-//! The foot is a point, the ground a surface described by a [`Terrain`]; the contact is computed
-//! against the tangent plane of the terrain below the foot. Every vector is in the global frame.
+//! The foot is a sphere of radius r (r = 0: the thesis' point foot), the ground a [`Terrain`];
+//! the penetration and the normal come from the closest point of the ground to the foot's centre
+//! ([`Terrain::proximity`]; on a plane, the tangent plane below the foot). Every vector is in the
+//! global frame.
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// A ground surface z = h(x, y).
-pub trait Terrain {
-    /// Height h of the ground below (x, y) and its unit normal n there, pointing out of the
-    /// ground (n_z > 0).
-    fn height_normal(&self, x: f64, y: f64) -> (f64, Vector3<f64>);
-}
-
-/// Horizontal ground at z = `height`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct FlatGround {
-    pub height: f64,
-}
-
-impl Terrain for FlatGround {
-    fn height_normal(&self, _x: f64, _y: f64) -> (f64, Vector3<f64>) {
-        (self.height, Vector3::z())
-    }
-}
-
-/// Inclined plane z = height + slope_x x + slope_y y.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Slope {
-    pub height: f64,
-    /// ∂h/∂x.
-    pub slope_x: f64,
-    /// ∂h/∂y.
-    pub slope_y: f64,
-}
-
-impl Slope {
-    /// A plane through (0, 0, `height`) rising at `angle` (rad) in the horizontal direction
-    /// `azimuth` (rad from x_0 about z_0).
-    pub fn from_angle(height: f64, angle: f64, azimuth: f64) -> Self {
-        let t = angle.tan();
-        Slope { height, slope_x: t * azimuth.cos(), slope_y: t * azimuth.sin() }
-    }
-}
-
-impl Terrain for Slope {
-    fn height_normal(&self, x: f64, y: f64) -> (f64, Vector3<f64>) {
-        (self.height + self.slope_x * x + self.slope_y * y, Vector3::new(-self.slope_x, -self.slope_y, 1.0).normalize())
-    }
-}
+use super::terrain::{Proximity, Terrain};
+#[cfg(test)]
+use super::terrain::{FlatGround, Slope};
 
 /// Parameters of the contact law, Eq. 3.72-3.73.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -65,13 +27,15 @@ pub struct GroundContact {
     pub mu: f64,
     /// Slip velocity v_glim of the linear zone of the Coulomb friction (m/s).
     pub v_glim: f64,
+    /// Radius r of the foot sphere (m); 0: the point foot of Section 3.4.2.
+    pub foot_radius: f64,
 }
 
 #[cfg(test)]
 impl Default for GroundContact {
     /// Table 3.3.
     fn default() -> Self {
-        GroundContact { k_gnd: 1e6, d_gnd: 5e4, p_k: 1.5, p_d: 0.5, mu: 0.3, v_glim: 1e-4 }
+        GroundContact { k_gnd: 1e6, d_gnd: 5e4, p_k: 1.5, p_d: 0.5, mu: 0.3, v_glim: 1e-4, foot_radius: 0.0 }
     }
 }
 
@@ -110,10 +74,11 @@ impl GroundContact {
 
     /// Contact force on a foot at `p` moving at `v` (the ground is fixed), Eq. 3.72-3.73.
     ///
-    /// The penetration is measured against the tangent plane below the foot: δ = n · (p_s - p)
-    /// with p_s = (x, y, h(x, y)) and n the terrain normal there. The Jacobians treat that plane
-    /// as fixed (∂δ/∂p = -nᵀ): exact for planar terrains, the curvature × penetration terms are
-    /// neglected on curved ones.
+    /// The penetration δ and the normal n are those of the closest point of the terrain to the
+    /// foot's centre p ([`Terrain::proximity`]); on a plane, δ = n · (p_s - p) + r with
+    /// p_s = (x, y, h(x, y)) below the foot. The Jacobians treat the tangent plane at the closest
+    /// point as fixed (∂δ/∂p = -nᵀ, the gradient of the distance): exact on planar faces, the
+    /// curvature × penetration terms of edges and vertices are neglected.
     ///
     /// For δ > 0, F_n = K δ^p_K + D δ^p_D dδ/dt (Eq. 3.72), clamped at zero: the ground never
     /// pulls the foot (no adhesion when the foot leaves the ground faster than the damping
@@ -121,8 +86,7 @@ impl GroundContact {
     /// dδ/dt ≠ 0. The friction is Coulomb with a linear zone (Eq. 3.73) on the tangential slip
     /// velocity v_g = v - (n · v) n.
     pub fn force<T: Terrain + ?Sized>(&self, p: &Vector3<f64>, v: &Vector3<f64>, terrain: &T) -> ContactForce {
-        let (h, n) = terrain.height_normal(p.x, p.y);
-        let delta = n.z * (h - p.z);
+        let Proximity { penetration: delta, normal: n } = terrain.proximity(p, self.foot_radius);
         let delta_rate = -n.dot(v);
         let projector = Matrix3::identity() - n * n.transpose();
         let slip = projector * v;

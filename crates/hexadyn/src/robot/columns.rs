@@ -18,10 +18,15 @@
 //! | `X_ref`, `Y_ref`, `Z_ref`; `yaw_ref`, `pitch_ref`, `roll_ref` | m; rad | desired body pose T*_{0,b} (gait) |
 //! | `X_dot_ref`, `Y_dot_ref`; `omega_z_ref` | m/s; rad/s | commanded heading velocities (gait) |
 //! | `duty_factor` | 1 | β of the current gait pattern (gait) |
-//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing (gait) |
+//! | `phase[l]` | 1 | foot phase code of leg l: 0 support, 1 takeoff, 2 swing, 3 landing, 4 failed and held up (gait) |
 //! | `foot_ref_x[l]`, `foot_ref_y[l]`, `foot_ref_z[l]` | m | foot reference in the leg frame (gait) |
+//! | `body_clearance` | m | body height above the ground plane estimated from the contact points (free gait, Section 7.7.5) |
+//! | `posture_roll`, `posture_pitch` | rad | body roll and pitch as the free gait knows them (navigation, else desired) |
+//! | `touchdown[l]` | 1 | 1 when the landing of leg l was detected at t (free gait) |
+//! | `deadlock` | 1 | 1 while the support legs are halted (free gait, Section 7.7.4) |
 //! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
 //! | `i_q_v[i]` ... | A | motor current |
+//! | `i_meas_q_v[i]` ... | A | motor current as the controller measured it at t: through the analog 30 Hz filter, with the sensor noise (Section 5.6.2, [`crate::physics::CurrentSensors`]) |
 //! | `tau_m_q_v[i]` ... | Nm (q_r), N | motor torque at the joint, n k_t i |
 //! | `tau_f_q_v[i]` ... | Nm (q_r), N | joint friction torque |
 //! | `z_q_v[i]` ... | rad (q_r), m | LuGre bristle deflection (friction `lugre` only) |
@@ -32,6 +37,12 @@
 //! | `E_kin`, `E_pot` | J | kinetic and gravitational potential energy |
 //! | `E_contact`, `E_stored`, `E_balance` | J | cumulative work on the ground; energy in bristles, ground springs and inductances; energy balance error |
 //!
+//! | `F_gnd_est[l]`, `gnd_detected[l]` | N; 1 | ground force estimate and detection flag of leg l (ground_detection) |
+//! | `gd_leg`, `gd_threshold`, `gd_trial`, `gd_hold`, `gd_stop` | 1; N; 1; 1; 1 | tested leg, threshold, trial, stopped flag, stop instant (ground_detection) |
+//!
+//! The columns marked (ground_detection) are those of the ground detection experiment
+//! ([`GroundExperimentState`], Section 5.6.3); a row with `gd_stop` = 1 is one trial of Table
+//! 5.7, whose true contact force is `Fn[gd_leg]` of the same row.
 //! The columns marked (gait) are those of the [`GaitState`] the gait controller publishes; the
 //! references and the bristles are recorded when [`ColumnGroups`] says so. Each column also
 //! carries a one-line description ([`crate::robot::recorder::Column`]).
@@ -39,7 +50,7 @@
 use super::recorder::Recorder;
 use super::simulation::SimulatedRobot;
 use crate::control::gait::schedule::GaitState;
-use crate::control::{Command, Measurements};
+use crate::control::{Command, GroundExperimentState, Measurements};
 use crate::hexapod::{Joint, JOINTS};
 
 /// The optional column groups of a run.
@@ -52,8 +63,9 @@ pub struct ColumnGroups {
 }
 
 /// Records the row of control instant `meas.t`: the robot `p` after the period, the command
-/// `cmd` the controller computed at t and, walking, the state the gait controller published.
-pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: &Command, groups: ColumnGroups, gait: Option<&GaitState>) {
+/// `cmd` the controller computed at t and, walking, the state the gait controller published, or
+/// in the ground detection experiment its state.
+pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, cmd: &Command, groups: ColumnGroups, gait: Option<&GaitState>, ground: Option<&GroundExperimentState>) {
     let st = p.state();
     let (q, qd) = (st.q.as_slice(), st.qd.as_slice());
     let out = &p.robot.outputs;
@@ -83,11 +95,17 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     if let Some(g) = gait {
         record_gait(rec, g);
     }
+    if let Some(g) = ground {
+        record_ground_detection(rec, g);
+    }
     for k in 0..JOINTS {
         rec.put(out.voltage[k], || (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
     }
     for k in 0..JOINTS {
         rec.put(out.current[k], || (joint_name("i_", k, ""), "A", s("motor current")));
+    }
+    for k in 0..JOINTS {
+        rec.put(meas.currents[k], || (joint_name("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
     }
     for k in 0..JOINTS {
         rec.put(out.motor_torque[k], || (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
@@ -130,7 +148,7 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
 }
 
 /// The gait controller's columns: desired body pose and velocities, duty factor, foot phases
-/// and foot references.
+/// and foot references; with the free gait its posture, detections and deadlock.
 pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
     let s = |x: &str| x.to_string();
     let pose = [g.pose.position.x, g.pose.position.y, g.pose.position.z, g.pose.angles.x, g.pose.angles.y, g.pose.angles.z];
@@ -141,15 +159,42 @@ pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
     rec.put(g.velocity.x, || (s("X_dot_ref"), "m/s", s("commanded heading velocity V_x (global)")));
     rec.put(g.velocity.y, || (s("Y_dot_ref"), "m/s", s("commanded heading velocity V_y (global)")));
     rec.put(g.omega.z, || (s("omega_z_ref"), "rad/s", s("commanded yaw rate Omega_z")));
-    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern")));
+    rec.put(g.beta, || (s("duty_factor"), "1", s("duty factor beta of the current gait pattern (NaN: free gait)")));
     for (l, phase) in g.phases.iter().enumerate() {
-        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing")));
+        rec.put(*phase, || (format!("phase[{l}]"), "1", s("foot phase code: 0 support, 1 takeoff, 2 swing, 3 landing, 4 failed (held up)")));
     }
     for (l, f) in g.feet.iter().enumerate() {
         rec.put(f.x, || (format!("foot_ref_x[{l}]"), "m", s("foot reference x, leg frame")));
         rec.put(f.y, || (format!("foot_ref_y[{l}]"), "m", s("foot reference y, leg frame")));
         rec.put(f.z, || (format!("foot_ref_z[{l}]"), "m", s("foot reference z, leg frame")));
     }
+    if let Some(free) = &g.free {
+        rec.put(free.clearance, || (s("body_clearance"), "m", s("body height above the ground plane estimated from the contact points (free gait)")));
+        rec.put(free.roll, || (s("posture_roll"), "rad", s("body roll as the free gait knows it (navigation, else desired)")));
+        rec.put(free.pitch, || (s("posture_pitch"), "rad", s("body pitch as the free gait knows it (navigation, else desired)")));
+        for (l, t) in free.touchdowns.iter().enumerate() {
+            rec.put(f64::from(u8::from(*t)), || (format!("touchdown[{l}]"), "1", s("1 when the landing of the leg was detected at t (free gait)")));
+        }
+        rec.put(f64::from(u8::from(free.deadlock)), || (s("deadlock"), "1", s("1 while the support legs are halted by a deadlock (free gait, Section 7.7.4)")));
+    }
+}
+
+/// The ground detection experiment's columns (Section 5.6.3): the detector's output per leg and
+/// the schedule.
+pub fn record_ground_detection(rec: &mut Recorder, g: &GroundExperimentState) {
+    let s = |x: &str| x.to_string();
+    for (l, d) in g.detections.iter().enumerate() {
+        rec.put(d.force, || (format!("F_gnd_est[{l}]"), "N", s("estimated vertical ground force on the foot from the motor current, F_z,gnd = alpha_21 tau_v,gnd (Eq. 5.22)")));
+    }
+    for (l, d) in g.detections.iter().enumerate() {
+        rec.put(f64::from(u8::from(d.detected)), || (format!("gnd_detected[{l}]"), "1", s("1: F_gnd_est at or above the threshold while the foot is lowered (Section 5.6.3)")));
+    }
+    let (leg, threshold, trial) = g.trial.map_or((-1.0, f64::NAN, -1.0), |(l, f, n)| (l as f64, f, n as f64));
+    rec.put(leg, || (s("gd_leg"), "1", s("leg under test in a sawtooth period (-1: none)")));
+    rec.put(threshold, || (s("gd_threshold"), "N", s("detection threshold of the current sawtooth period (NaN: none)")));
+    rec.put(trial, || (s("gd_trial"), "1", s("trial of the current threshold, from 0 (-1: none)")));
+    rec.put(f64::from(u8::from(g.holding)), || (s("gd_hold"), "1", s("1: the tested leg is stopped on a detection")));
+    rec.put(f64::from(u8::from(g.stop.is_some())), || (s("gd_stop"), "1", s("1: the tested leg stopped at this instant (a row of Table 5.7: the true force is Fn[gd_leg])")));
 }
 
 /// Unit of a joint quantity: (rotational, translational).

@@ -20,7 +20,7 @@ use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Terrain};
-use crate::physics::{DryViscous, FrictionElement, JointFriction, LuGre, SteadyState};
+use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
@@ -81,6 +81,13 @@ pub struct ModelOptions {
     /// Supply voltage at the H-bridges (V).
     pub supply_voltage: f64,
     pub control: JointControl,
+    /// The body held still on a stand (the identification rig of Section 5.2, "leg in the
+    /// air"): the six body rows of the residual become q''_body = 0.
+    pub stand: bool,
+    /// Upward force on each foot (N), the load of the identification rig (Fig. 5.6: 10 kg at
+    /// the foot playing the role of the ground reaction, Sections 5.3-5.4). It acts like a
+    /// ground force: it is added to the foot force and to the leg load of Eq. 5.12.
+    pub foot_load: [f64; 6],
 }
 
 impl ModelOptions {
@@ -91,9 +98,11 @@ impl ModelOptions {
             friction,
             load_dependence: false,
             inductance: false,
-            ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s },
+            ground: GroundContact { k_gnd: g.k_gnd_n_per_m_pk, d_gnd: g.d_gnd_ns_per_m_pd1, p_k: g.p_k, p_d: g.p_d, mu: g.mu, v_glim: g.v_glim_m_per_s, foot_radius: 0.0 },
             supply_voltage: d.driver.supply_voltage_v,
             control: JointControl::Digital,
+            stand: false,
+            foot_load: [0.0; 6],
         }
     }
 }
@@ -108,7 +117,7 @@ pub struct RobotModel {
     /// Joint strokes (limit switches), per joint type.
     pub strokes: [RangeInclusive<f64>; 3],
     pub options: ModelOptions,
-    pub terrain: Arc<dyn Terrain + Send + Sync>,
+    pub terrain: Arc<dyn Terrain>,
     /// Continuous joint controllers (Eq. 3.96-3.97), with [`JointControl::ContinuousPid`].
     pub pids: Option<[ContinuousPid; JOINTS]>,
     layout: Layout,
@@ -120,12 +129,11 @@ pub struct RobotModel {
 
 fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
     // The description's parameters carry the thesis names of the laws' parameters.
-    let JointFrictionParameters {
-        tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, epsilon, load_dependence, ..
-    } = d.friction(leg, joint);
+    let parameters = d.friction(leg, joint);
+    let JointFrictionParameters { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, load_dependence, .. } = parameters;
     let law = match options.friction {
         FrictionModel::None => JointFriction::None,
-        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_f_d_plus, tau_f_d_minus, f_v_plus, f_v_minus, epsilon }),
+        FrictionModel::DryViscous => JointFriction::DryViscous(parameters.dry_viscous()),
         FrictionModel::LuGre => {
             // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
             // (horizontal, viscous effects neglected).
@@ -145,7 +153,7 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &Mo
 }
 
 impl RobotModel {
-    pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain + Send + Sync>) -> Self {
+    pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
         let motor = |joint: Joint| DcMotor {
             r: d.motor.resistance_ohm,
@@ -221,23 +229,34 @@ impl RobotModel {
         self.currents.map(|c| c + k)
     }
 
-    /// Initial q for the given joint positions: level body at (0, 0, Z), Z chosen so that the
-    /// lowest foot just touches the terrain; all other states zero.
+    /// Initial q for the given joint positions: body at (0, 0, Z) with zero yaw, parallel to the
+    /// terrain below its origin (level on flat ground), Z chosen so that the lowest foot just
+    /// touches the terrain (closest point: zero penetration); all other states zero.
     pub fn touching_ground(&self, joints: &[f64; JOINTS]) -> Vec<f64> {
         let mut q = vec![0.0; self.coordinate_count()];
         q[6..DOF].copy_from_slice(joints);
+        // z_b = n: R_y(Θ) R_x(Ψ) e_z = (sin Θ cos Ψ, −sin Ψ, cos Θ cos Ψ) (Eq. 3.52 with Φ = 0).
+        let n = self.terrain.height_normal(0.0, 0.0).1;
+        (q[4], q[5]) = (n.x.atan2(n.z), (-n.y).asin());
         let mech = &self.mechanics;
         let mut data = Data::new(&mech.model);
-        mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
-        let clearance = mech
-            .legs
-            .iter()
-            .map(|b| {
-                let p = data.point(b.links[3], &mech.foot_local);
-                p.z - self.terrain.height_normal(p.x, p.y).0
-            })
-            .fold(f64::INFINITY, f64::min);
-        q[2] = -clearance;
+        let mut clearance = |q: &[f64]| {
+            mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
+            mech.legs
+                .iter()
+                .map(|b| -self.terrain.proximity(&data.point(b.links[3], &mech.foot_local), self.options.ground.foot_radius).penetration)
+                .fold(f64::INFINITY, f64::min)
+        };
+        q[2] = -clearance(&q);
+        // Off a plane the closest point is not below the foot: lowering the body by the
+        // clearance leaves a clearance >= 0 (the distance is 1-Lipschitz); repeat until touching.
+        for _ in 0..100 {
+            let c = clearance(&q);
+            if c.abs() <= 1e-12 {
+                break;
+            }
+            q[2] -= c;
+        }
         q
     }
 
@@ -421,7 +440,10 @@ impl Robot {
         for (leg, bodies) in mech.legs.iter().enumerate() {
             let p = self.data.point(bodies.links[3], &mech.foot_local);
             let v = self.data.point_velocity(bodies.links[3], &p);
-            let c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            let mut c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v.
+            c.force.z += m.options.foot_load[leg];
+            c.normal_force += m.options.foot_load[leg];
             if c.force != Vector3::zeros() {
                 self.data.add_force(bodies.links[3], &p, &c.force);
             }
@@ -455,6 +477,9 @@ impl Robot {
         self.evaluate(q, qd, qdd);
         let m = &*self.model;
         mbs::residual(&m.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
+        if m.options.stand {
+            f[..BODY].copy_from_slice(&qdd[..BODY]);
+        }
         for k in 0..JOINTS {
             let j = 6 + k;
             if let Some(b) = m.bristles {
@@ -479,6 +504,9 @@ impl Robot {
     fn write_mass_matrix(&self, qd: &[f64], qdd: &[f64], mass: &mut DMatrix<f64>) {
         let m = &*self.model;
         mbs::mass_matrix(&m.mechanics.model, &self.data, mass);
+        if m.options.stand {
+            held_body_rows(mass, 1.0);
+        }
         for k in 0..JOINTS {
             let j = 6 + k;
             let load = self.outputs.contact[k / 3].normal_force;
@@ -616,6 +644,10 @@ impl System for Robot {
                 }
             }
         }
+        if m.options.stand {
+            held_body_rows(&mut jac.kt, 0.0);
+            held_body_rows(&mut jac.ct, 0.0);
+        }
         true
     }
 
@@ -640,6 +672,18 @@ impl System for Robot {
             None => self.voltages[k] = value,
             Some(_) => self.references[k] = value,
         }
+    }
+}
+
+/// Number of body coordinates (X, Y, Z, yaw, pitch, roll), first in q.
+const BODY: usize = 6;
+
+/// The body rows of a Jacobian block of the robot on a stand (f_body = q''_body): zero, with
+/// `diagonal` on the diagonal (1 for M, 0 for CT and KT).
+fn held_body_rows(block: &mut DMatrix<f64>, diagonal: f64) {
+    block.rows_mut(0, BODY).fill(0.0);
+    for i in 0..BODY {
+        block[(i, i)] = diagonal;
     }
 }
 

@@ -1,5 +1,6 @@
 //! The simulated robot as a [`Plant`]: the robot model integrated by Newmark between control
-//! instants, encoders quantizing the joint positions, and an energy account integrated at every
+//! instants, encoders quantizing the joint positions, the current sensors (analog 30 Hz filter and
+//! optional noise, Section 5.6.2) integrated at every accepted step, and an energy account integrated at every
 //! accepted step (electrical input, Joule, friction and contact losses, stored energies).
 
 use std::ops::ControlFlow;
@@ -10,7 +11,7 @@ use crate::description::RobotDescription;
 use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant};
 use crate::hexapod::JOINTS;
 use crate::mbs;
-use crate::physics::JointFriction;
+use crate::physics::{CurrentSensing, CurrentSensors, JointFriction};
 use crate::sim::{Newmark, NewmarkOptions, SimError, State};
 
 /// Energies (J) accumulated since the start, by trapezoidal integration of the powers at the
@@ -116,6 +117,8 @@ pub struct PlantOptions {
     pub encoder_counts: u32,
     /// Whether the controller receives the true body pose (navigation system, Section 7.4).
     pub navigation: bool,
+    /// The current sensors (Section 5.6.2): analog filter cut-off, noise and its seed.
+    pub current_sensing: CurrentSensing,
 }
 
 impl PlantOptions {
@@ -132,6 +135,7 @@ impl PlantOptions {
             period: d.controller.period_s,
             encoder_counts: d.controller.encoder_impulses_per_rev,
             navigation: false,
+            current_sensing: CurrentSensing::default(),
         }
     }
 }
@@ -144,6 +148,7 @@ pub struct SimulatedRobot {
     /// The energy account at the start, for balances.
     pub initial_energy: EnergyAccount,
     encoders: [Encoder; JOINTS],
+    current_sensors: CurrentSensors<JOINTS>,
     period: f64,
     navigation: bool,
 }
@@ -154,8 +159,10 @@ impl SimulatedRobot {
         let mut robot = Robot::new(model);
         let integrator = Newmark::new(&mut robot, 0.0, q, qd, options.integrator.clone())?;
         let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: options.encoder_counts, n: robot.model.motors[k].n });
-        let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), encoders, period: options.period, navigation: options.navigation };
+        let current_sensors = CurrentSensors::new(&options.current_sensing, 0.0, &[0.0; JOINTS]);
+        let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), encoders, current_sensors, period: options.period, navigation: options.navigation };
         plant.observe();
+        plant.current_sensors = CurrentSensors::new(&options.current_sensing, plant.state().t, &plant.robot.outputs.current);
         plant.initial_energy = plant.energy.clone();
         Ok(plant)
     }
@@ -185,9 +192,10 @@ impl Plant for SimulatedRobot {
         Measurements {
             t: s.t,
             positions: std::array::from_fn(|k| self.encoders[k].measure(q[6 + k])),
-            currents: self.robot.outputs.current,
+            currents: self.current_sensors.sample(),
             supply_voltage: self.robot.model.options.supply_voltage,
             pose: self.navigation.then(|| BodyPose { position: nalgebra::Vector3::new(q[0], q[1], q[2]), yaw: q[3], pitch: q[4], roll: q[5] }),
+            foot_normal_forces: Some(self.robot.outputs.contact.map(|c| c.normal_force)),
         }
     }
 
@@ -201,11 +209,18 @@ impl Plant for SimulatedRobot {
         // the power integration of the period from the powers under the new voltages.
         self.integrator.reset_accelerations(&mut self.robot)?;
         self.observe();
-        let t_end = self.integrator.state().t + self.period;
-        let energy = &mut self.energy;
+        let t_start = self.integrator.state().t;
+        // The current jumps with the voltage: the input of the analog filters jumps.
+        self.current_sensors.advance(t_start, &self.robot.outputs.current);
+        let t_end = t_start + self.period;
+        let (energy, sensors) = (&mut self.energy, &mut self.current_sensors);
         // The outputs of each accepted step are those of its last Newton iterate, within the
-        // Newton tolerance of the accepted state: no extra evaluation per step.
-        self.integrator.advance_to_observed(&mut self.robot, t_end, |robot, state| energy.accumulate(robot, state))?;
+        // Newton tolerance of the accepted state: no extra evaluation per step. Between accepted
+        // steps the current is taken linear for the analog filters.
+        self.integrator.advance_to_observed(&mut self.robot, t_end, |robot, state| {
+            energy.accumulate(robot, state);
+            sensors.advance(state.t, &robot.outputs.current);
+        })?;
         // The last accepted step landed on t_end: the outputs are those of the current state
         // (to the Newton tolerance).
         Ok(())

@@ -14,7 +14,8 @@ use crate::control::{Command, Controller, Measurements};
 use crate::robot::columns::record_gait;
 use crate::robot::recorder::Recorder;
 
-/// The controller a scenario runs (gait, PI loops or unpowered), as in [`super::run_scenario`].
+/// The controller a scenario runs (gait, PI loops, ground detection experiment or unpowered), as
+/// in [`super::run_scenario`]. Only the gait columns are recorded by the other drivers.
 pub struct ScenarioController {
     controller: Box<dyn Controller>,
     gait: Option<Rc<RefCell<GaitState>>>,
@@ -22,8 +23,8 @@ pub struct ScenarioController {
 
 impl ScenarioController {
     pub fn new(s: &Scenario) -> Self {
-        let (controller, gait) = controller(s);
-        ScenarioController { controller, gait }
+        let (controller, published) = controller(s);
+        ScenarioController { controller, gait: published.gait }
     }
 
     /// The recorder of the gait columns, which stays readable while the controller is driven.

@@ -13,11 +13,13 @@ use serde::Deserialize;
 
 use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
+use super::terrain::{self, RawTerrain};
 use super::{joint_number, ControlMode, Initial, ModelFlags, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
-use crate::control::JointMotion;
+use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
 use crate::hexapod::{Joint, JOINTS};
+use crate::physics::LOAD_GRAVITY;
 use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
 
@@ -39,6 +41,19 @@ pub(super) struct RawScenario {
     #[serde(default)]
     control: RawControl,
     gait: Option<RawGait>,
+    terrain: Option<RawTerrain>,
+    #[serde(default)]
+    sensors: RawSensors,
+    ground_detection: Option<GroundExperiment>,
+}
+
+/// `[sensors]`: the current sensors of the plant (Section 5.6.2).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSensors {
+    current_noise_a: Option<f64>,
+    #[serde(default)]
+    seed: u64,
 }
 
 /// `[scenario]`.
@@ -70,9 +85,13 @@ struct RawModel {
     k_gnd: Option<f64>,
     d_gnd: Option<f64>,
     mu: Option<f64>,
+    foot_radius_m: Option<f64>,
     supply_voltage_v: Option<f64>,
     #[serde(default)]
     joint_friction: RawJointFriction,
+    #[serde(default)]
+    stand: bool,
+    foot_load_kg: Option<Vec<f64>>,
 }
 
 impl RawScenario {
@@ -88,7 +107,7 @@ fn default_friction() -> FrictionModel {
 
 impl Default for RawModel {
     fn default() -> Self {
-        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, supply_voltage_v: None, joint_friction: Default::default() }
+        RawModel { friction: default_friction(), load_dependence: false, inductance: false, k_gnd: None, d_gnd: None, mu: None, foot_radius_m: None, supply_voltage_v: None, joint_friction: Default::default(), stand: false, foot_load_kg: None }
     }
 }
 
@@ -162,6 +181,7 @@ enum MotionKind {
     Ramp,
     Sine,
     Sawtooth,
+    VoltageRamp,
 }
 
 /// One `[[control.motion]]`.
@@ -179,6 +199,9 @@ struct RawMotion {
     min: Option<f64>,
     max: Option<f64>,
     speed: Option<f64>,
+    speed_step: Option<f64>,
+    speed_max: Option<f64>,
+    rate_v_per_s: Option<f64>,
 }
 
 // =============================================================================================
@@ -272,10 +295,26 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         in_range(c, "model.mu", v, MU_RANGE, "", "a foot-ground friction coefficient (rubber on rough ground is below 1.5)")?;
         model.ground.mu = v;
     }
+    if let Some(v) = m.foot_radius_m {
+        c.check((0.0..=0.05).contains(&v), "model.foot_radius_m", v, "a radius in [0, 0.05] m (0: the point foot of Section 3.4.2)").map_err(e)?;
+        model.ground.foot_radius = v;
+    }
+    let terrain = terrain::validate(raw.terrain.as_ref(), c, dir).map_err(e)?;
     if let Some(v) = m.supply_voltage_v {
         let rated = robot.motor.nominal_voltage_v;
         in_range(c, "model.supply_voltage_v", v, [SUPPLY_MIN_V, 2.0 * rated], "V", &format!("up to twice the motors' nominal voltage ({rated} V): the motor model has no limit beyond it"))?;
         model.supply_voltage = v;
+    }
+    model.stand = m.stand;
+    if let Some(loads) = &m.foot_load_kg {
+        let shown = format!("{loads:?}");
+        if loads.len() != 6 {
+            return Err(e(c.err("model.foot_load_kg", &shown, &format!("{} values", loads.len()), "six masses >= 0 (kg), one per leg 0..5")));
+        }
+        for (leg, &kg) in loads.iter().enumerate() {
+            c.non_negative(&format!("model.foot_load_kg[{leg}]"), kg).map_err(e)?;
+            model.foot_load[leg] = kg * LOAD_GRAVITY;
+        }
     }
 
     // Integrator.
@@ -305,6 +344,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     if let Some(g) = &gait {
         plant.navigation = g.navigation;
     }
+    if let Some(v) = raw.sensors.current_noise_a {
+        c.non_negative("sensors.current_noise_a", v).map_err(e)?;
+        plant.current_sensing.noise_a = v;
+    }
+    plant.current_sensing.seed = raw.sensors.seed;
 
     // Initial configuration.
     let i = &raw.initial;
@@ -396,6 +440,17 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         motions.push(motion);
     }
 
+    let ground_detection = match (mode, &raw.ground_detection) {
+        (ControlMode::GroundDetection, Some(g)) => Some(validate_ground_detection(g, c, &robot, &initial).map_err(e)?),
+        (ControlMode::GroundDetection, None) => {
+            return Err(e(c.err("ground_detection", "<missing>", "missing table", "a [ground_detection] table with control.mode = \"ground_detection\" (see python/hexadyn/scenarios/ground_detection.toml)")));
+        }
+        (_, Some(_)) => {
+            return Err(e(c.err("ground_detection", "[ground_detection]", &format!("a [ground_detection] table with control.mode = \"{}\"", mode.name()), "control.mode = \"ground_detection\" with the table (or no table)")));
+        }
+        (_, None) => None,
+    };
+
     Ok(Scenario {
         name: h.name.clone(),
         description: h.description.clone(),
@@ -409,6 +464,8 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         control: mode,
         motions,
         gait,
+        terrain,
+        ground_detection,
         origin: origin.to_string(),
         text: text.to_string(),
     })
@@ -432,9 +489,22 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
     let (kind, used): (&str, &[&str]) = match m.kind {
         MotionKind::Ramp => ("ramp", &["rate", "start_s", "stop_s"]),
         MotionKind::Sine => ("sine", &["amplitude", "frequency_hz"]),
-        MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed"]),
+        MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed", "speed_step", "speed_max"]),
+        MotionKind::VoltageRamp => ("voltage_ramp", &["rate_v_per_s"]),
     };
-    let fields = [("rate", m.rate), ("start_s", m.start_s), ("stop_s", m.stop_s), ("amplitude", m.amplitude), ("frequency_hz", m.frequency_hz), ("min", m.min), ("max", m.max), ("speed", m.speed)];
+    let fields = [
+        ("rate", m.rate),
+        ("start_s", m.start_s),
+        ("stop_s", m.stop_s),
+        ("amplitude", m.amplitude),
+        ("frequency_hz", m.frequency_hz),
+        ("min", m.min),
+        ("max", m.max),
+        ("speed", m.speed),
+        ("speed_step", m.speed_step),
+        ("speed_max", m.speed_max),
+        ("rate_v_per_s", m.rate_v_per_s),
+    ];
     for (name, value) in fields {
         if let Some(v) = value {
             if !used.contains(&name) {
@@ -480,10 +550,62 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
             c.check(min >= lo - tol && min <= base, &field("min"), min, &format!("a value in [{lo_s}, {base_s}] {unit}: within {stroke_text}, at most the base"))?;
             c.check(max <= hi + tol && max >= base && max > min, &field("max"), max, &format!("a value in [{base_s}, {hi_s}] {unit} and > min: within {stroke_text}, at least the base"))?;
             c.positive(&field("speed"), speed)?;
-            JointMotion::Sawtooth { min, max, speed }
+            // Optional staircase of Table 5.2: both keys or neither.
+            match (m.speed_step, m.speed_max) {
+                (None, None) => JointMotion::Sawtooth { min, max, speed },
+                (Some(speed_step), Some(speed_max)) => {
+                    c.positive(&field("speed_step"), speed_step)?;
+                    c.check(speed_max >= speed, &field("speed_max"), speed_max, &format!("a speed >= speed = {speed} {unit}/s"))?;
+                    JointMotion::SawtoothSteps { min, max, speed, speed_step, speed_max }
+                }
+                (Some(v), None) | (None, Some(v)) => {
+                    let name = if m.speed_step.is_some() { "speed_max" } else { "speed_step" };
+                    return Err(c.err(&field(name), "<missing>", "missing field", format!("speed_step and speed_max together (the speed staircase of Table 5.2; the other is {v})")));
+                }
+            }
+        }
+        MotionKind::VoltageRamp => {
+            let rate = required("rate_v_per_s", m.rate_v_per_s)?;
+            c.check(rate.is_finite() && rate != 0.0, &field("rate_v_per_s"), rate, "a finite, non-zero voltage rate (V/s; Section 5.3 uses 0.05, or -0.05 for the minus sense)")?;
+            JointMotion::VoltageRamp { rate_v_per_s: rate }
         }
     };
     Ok(Motion { leg, joint, motion })
+}
+
+/// `[ground_detection]`: legs 0..5 each at most once, positive thresholds, at least one trial,
+/// a sawtooth inside the q_v stroke around the initial q_v of each tested leg, and a period of
+/// at least four control periods.
+fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &RobotDescription, initial: &Initial) -> std::result::Result<GroundExperiment, DescriptionError> {
+    if g.legs.is_empty() {
+        return Err(c.err("ground_detection.legs", "[]", "no leg to test", "a list of legs 0..5"));
+    }
+    for (n, &leg) in g.legs.iter().enumerate() {
+        let field = format!("ground_detection.legs[{n}]");
+        if leg >= 6 {
+            return Err(c.err(&field, leg, "no such leg", "a leg number 0..5"));
+        }
+        if g.legs[..n].contains(&leg) {
+            return Err(c.err(&field, leg, "listed twice", "each leg at most once"));
+        }
+        if initial.lifted_legs.contains(&leg) {
+            return Err(c.err(&field, leg, "a lifted leg", "a leg standing on the ground at the start (not in initial.lifted_legs)"));
+        }
+    }
+    if g.thresholds.is_empty() {
+        return Err(c.err("ground_detection.thresholds_n", "[]", "no threshold", "a list of forces > 0 (N), e.g. [40, 50, 60]"));
+    }
+    for (n, &f) in g.thresholds.iter().enumerate() {
+        c.positive(&format!("ground_detection.thresholds_n[{n}]"), f)?;
+    }
+    c.check(g.trials >= 1, "ground_detection.trials", g.trials as f64, "an integer >= 1")?;
+    let period = robot.controller.period_s;
+    c.check(g.period.is_finite() && g.period >= 4.0 * period, "ground_detection.period_s", g.period, &format!("a finite period >= {} s (four control periods)", 4.0 * period))?;
+    let (lo, hi) = robot.joint_range(Joint::Vertical);
+    let tol = STROKE_TOLERANCE * (hi - lo);
+    let room = g.legs.iter().map(|&l| initial.joints[3 * l + 1]).map(|q| (q - lo).min(hi - q)).fold(f64::INFINITY, f64::min);
+    c.check(g.amplitude > 0.0 && g.amplitude <= room + tol, "ground_detection.amplitude_m", g.amplitude, &format!("a value in (0, {}] m, so that q_v ± amplitude stays in the q_v stroke [{}, {}] m around initial.q_v_m", short(room), short(lo), short(hi)))?;
+    Ok(g.clone())
 }
 
 /// A number with at most 6 decimals, trailing zeros removed (0.4363323129985824 -> 0.436332).

@@ -14,18 +14,22 @@ use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::control::gait::controller::{joints_at, steady_footholds, AepMode, GaitController, GaitOptions};
+use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDetector, NormalForce, THESIS_FORCE_THRESHOLD};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
-use crate::control::gait::schedule::{GaitChange, GaitState, ScheduledGait};
-use crate::control::joint_pis;
+use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
+use crate::control::{joint_pis, Controller};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::RobotDescription;
 
 type Result<T> = std::result::Result<T, DescriptionError>;
 
-/// Default foot clearance (m).
-pub const DEFAULT_CLEARANCE: f64 = 0.045;
+/// Default foot clearance, the lift at mid-swing (m). INTERPRETATION (docs/validation-walk.md):
+/// the lift of the validation walk, fitted to the 0.8 mm largest vertical tracking error of
+/// Section 6.4.2 and above the 8 cm step the same takeoff generation crosses (Section 7.7.5);
+/// no table of the thesis gives it.
+pub const DEFAULT_CLEARANCE: f64 = 0.105;
 /// Default overlap Δφ of the enhanced cycle (Table 6.2).
 pub const DEFAULT_OVERLAP: f64 = 0.05;
 /// Default duty factor of the wave and equal-phase gaits.
@@ -46,21 +50,36 @@ enum CycleKind {
     Plain,
 }
 
-fn default_aep() -> AepMode {
-    AepMode::Periodic
+/// `gait.pattern`: a periodic pattern, or the free gait of Section 7.7.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+enum RawPattern {
+    Tripod,
+    Wave,
+    EqualPhase,
+    Free,
+}
+
+impl RawPattern {
+    fn periodic(self) -> Option<GaitKind> {
+        match self {
+            RawPattern::Tripod => Some(GaitKind::Tripod),
+            RawPattern::Wave => Some(GaitKind::Wave),
+            RawPattern::EqualPhase => Some(GaitKind::EqualPhase),
+            RawPattern::Free => None,
+        }
+    }
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawGait {
-    period_s: f64,
-    pattern: GaitKind,
+    period_s: Option<f64>,
+    pattern: RawPattern,
     duty_factor: Option<f64>,
-    #[serde(default)]
-    cycle: CycleKind,
+    cycle: Option<CycleKind>,
     overlap: Option<f64>,
-    #[serde(default = "default_aep")]
-    aep: AepMode,
+    aep: Option<AepMode>,
     clearance_m: Option<f64>,
     #[serde(default)]
     navigation: bool,
@@ -68,6 +87,30 @@ pub(super) struct RawGait {
     heading: RawHeading,
     #[serde(default)]
     change: Vec<RawChange>,
+    free: Option<RawFree>,
+}
+
+/// How the free gait detects the landings (`gait.free.landing`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum LandingKind {
+    /// The true normal force above a threshold: the simulation mode of Section 7.7.
+    #[default]
+    Force,
+}
+
+/// `[gait.free]`: the free gait's parameters.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawFree {
+    takeoff_s: Option<f64>,
+    swing_s: Option<f64>,
+    posture_time_s: Option<f64>,
+    #[serde(default)]
+    landing: LandingKind,
+    landing_threshold_n: Option<f64>,
+    failed_leg: Option<i64>,
+    stability_margin_m: Option<f64>,
 }
 
 /// Kind of heading source in `[gait.heading]`.
@@ -152,11 +195,38 @@ impl HeadingSpec {
     }
 }
 
+/// The landing detection of a free gait scenario.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LandingSpec {
+    /// [`NormalForce`] with its threshold (N).
+    Force { threshold: f64 },
+}
+
+impl LandingSpec {
+    /// A fresh detector for a run. The current-based detector of Section 5.6 plugs in here.
+    pub fn detector(&self) -> Box<dyn LandingDetector> {
+        match *self {
+            LandingSpec::Force { threshold } => Box::new(NormalForce { threshold }),
+        }
+    }
+}
+
+/// The free gait of a scenario (`pattern = "free"`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FreeGaitSpec {
+    pub options: FreeGaitOptions,
+    pub landing: LandingSpec,
+}
+
 /// The validated `[gait]` table, SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GaitScenario {
-    /// Period, initial pattern, foot cycle, AEP mode, clearance (`lift`) and control period.
+    /// Period, initial pattern, foot cycle, AEP mode, clearance (`lift`) and control period. For
+    /// the free gait only `lift` and `dt` apply: the pattern is named "free", the period and
+    /// the duty factor are NaN (no fixed cycle).
     pub options: GaitOptions,
+    /// The free gait's parameters, with `pattern = "free"`.
+    pub free: Option<FreeGaitSpec>,
     pub heading: HeadingSpec,
     /// Whether the controller receives the true body pose.
     pub navigation: bool,
@@ -171,12 +241,23 @@ pub struct GaitScenario {
 }
 
 impl GaitScenario {
-    /// A fresh gait controller for a run, with the scheduled gait changes and the 18 PI loops of
-    /// the robot, and the state it publishes after each update.
-    pub fn controller(&self, robot: &RobotDescription) -> (ScheduledGait, Rc<RefCell<GaitState>>) {
+    /// A fresh gait controller for a run (the periodic one with the scheduled gait changes, or
+    /// the free gait) with the 18 PI loops of the robot, and the state it publishes after each
+    /// update.
+    pub fn controller(&self, robot: &RobotDescription) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
         let pis = joint_pis(robot, self.options.dt);
-        let controller = GaitController::new(self.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source());
-        ScheduledGait::new(controller, self.changes.clone())
+        match &self.free {
+            Some(free) => {
+                let controller = FreeGaitController::new(free.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector());
+                let (c, state) = PublishedFreeGait::new(controller);
+                (Box::new(c), state)
+            }
+            None => {
+                let controller = GaitController::new(self.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source());
+                let (c, state) = ScheduledGait::new(controller, self.changes.clone());
+                (Box::new(c), state)
+            }
+        }
     }
 }
 
@@ -217,44 +298,16 @@ fn duty_factor(c: &Ctx, field: &str, kind: GaitKind, value: Option<f64>, cycle: 
 /// Validates the `[gait]` table. `duration` is the scenario's (s).
 pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Path, duration: f64) -> Result<GaitScenario> {
     let dt = robot.controller.period_s;
-
-    // Foot cycle.
-    let cycle = match g.cycle {
-        CycleKind::Plain => {
-            if let Some(v) = g.overlap {
-                return Err(c.err("gait.overlap", v, "not a field of cycle = \"plain\"", "no overlap with the plain cycle (or cycle = \"enhanced\")"));
-            }
-            FootCycle::Plain
-        }
-        CycleKind::Enhanced => {
-            let overlap = g.overlap.unwrap_or(DEFAULT_OVERLAP);
-            c.check(overlap > 0.0 && overlap < 0.125, "gait.overlap", overlap, "an overlap Δφ in (0, 0.125) (cycle fraction; the takeoff, swing and landing fill 1 − β − Δφ of the cycle, so β + 4Δφ < 1 with β >= 0.5; Table 6.2: 0.05), or cycle = \"plain\"")?;
-            FootCycle::Enhanced { overlap }
+    let periodic = match g.pattern.periodic() {
+        Some(kind) => Some(periodic_pattern(g, c, kind, dt, duration)?),
+        None => {
+            reject_periodic_fields(g, c)?;
+            None
         }
     };
-
-    // Patterns: the initial one and the changes.
-    let beta = duty_factor(c, "gait.duty_factor", g.pattern, g.duty_factor, cycle)?;
-    let pattern = GaitPattern::of(g.pattern, beta);
-    let mut changes = Vec::new();
-    let mut previous = 0.0;
-    for (n, ch) in g.change.iter().enumerate() {
-        let field = |name: &str| format!("gait.change[{n}].{name}");
-        c.check(ch.at_s > previous && ch.at_s < duration, &field("at_s"), ch.at_s, &format!("a time in ({previous}, {duration}) s: after the start{} and before the end of the scenario", if n > 0 { " and the previous change" } else { "" }))?;
-        previous = ch.at_s;
-        let b = duty_factor(c, &field("duty_factor"), ch.pattern, ch.duty_factor, cycle)?;
-        changes.push(GaitChange { at: ch.at_s, pattern: GaitPattern::of(ch.pattern, b) });
+    if let (Some(_), Some(_)) = (&periodic, &g.free) {
+        return Err(c.err("gait.free", "[gait.free]", "a free gait table with a periodic pattern", "pattern = \"free\" with [gait.free] (or no [gait.free] table)"));
     }
-    let patterns: Vec<&GaitPattern> = std::iter::once(&pattern).chain(changes.iter().map(|ch| &ch.pattern)).collect();
-
-    // Period: every swing, takeoff and landing lasts at least one control period.
-    let shortest = patterns
-        .iter()
-        .map(|p| cycle.swing_fraction(p.beta))
-        .chain((cycle.transition_fraction() > 0.0).then(|| cycle.transition_fraction()))
-        .fold(f64::INFINITY, f64::min);
-    let min_period = dt / shortest;
-    c.check(g.period_s >= min_period * (1.0 - 1e-9), "gait.period_s", g.period_s, &format!("a leg cycle time >= {min_period:.4} s, so that the swing{} each last at least one control period ({dt} s)", if cycle.transition_fraction() > 0.0 { ", the takeoff and the landing" } else { "" }))?;
 
     let clearance = g.clearance_m.unwrap_or(DEFAULT_CLEARANCE);
     c.positive("gait.clearance_m", clearance)?;
@@ -306,8 +359,14 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
     let workspaces: [Workspace; 6] = workspaces.try_into().expect("six legs");
     let heading = validate_heading(&g.heading, c, dir)?;
 
+    let Some(p) = periodic else {
+        return free_gait(g, c, heading, height, legs, workspaces, clearance, dt, &reach, given);
+    };
+    let (cycle, period_s) = (p.cycle, p.period);
+    let patterns: Vec<&GaitPattern> = std::iter::once(&p.pattern).chain(p.changes.iter().map(|ch| &ch.pattern)).collect();
+
     // Strokes: every support stroke, |v_C| x support time, fits the workspace diameter.
-    let support = patterns.iter().map(|p| cycle.support_fraction(p.beta)).fold(0.0, f64::max) * g.period_s;
+    let support = patterns.iter().map(|p| cycle.support_fraction(p.beta)).fold(0.0, f64::max) * period_s;
     // Only the instants where the heading can be largest are checked (a bounded number, not
     // one per control period of a possibly very long run).
     let mut source = heading.source();
@@ -337,17 +396,145 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
             format!(
                 "|v_C| <= {:.4} m/s with gait.period_s = {} s (v_C = v + Ω_z x r_C at the workspace centre; Section 7.5), or a gait.period_s <= {:.3} s",
                 2.0 * r / support,
-                g.period_s,
-                g.period_s / worst_ratio
+                period_s,
+                period_s / worst_ratio
             ),
         ));
     }
 
-    let options = GaitOptions { period: g.period_s, pattern, cycle, aep: g.aep, lift: clearance, dt };
+    let options = GaitOptions { period: period_s, pattern: p.pattern, cycle, aep: p.aep, lift: clearance, dt };
     let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading.source().heading(0.0));
     let joints = joints_at(&legs, &footholds)
         .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.clone()))?;
-    Ok(GaitScenario { options, heading, navigation: g.navigation, body_height: height, legs, workspaces, changes, joints })
+    Ok(GaitScenario { options, free: None, heading, navigation: g.navigation, body_height: height, legs, workspaces, changes: p.changes, joints })
+}
+
+/// Default takeoff duration of the free gait (s).
+///
+/// INTERPRETATION: Section 7.7.3 fixes the takeoff time without giving it; the enhanced cycle
+/// of the validation walks (Table 6.2, T = 12 s, Δφ = 5 %) takes off in 1.5 Δφ T = 0.9 s. 1 s.
+pub const DEFAULT_TAKEOFF_S: f64 = 1.0;
+/// Section 7.7.3: the swing's constant time, "fixed in our case at 3 s".
+pub const DEFAULT_SWING_S: f64 = 3.0;
+/// Section 7.7.1: t_post "has been set to 2 s".
+pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
+/// Smallest static stability margin when a leg lifts on five legs (m).
+///
+/// INTERPRETATION (beyond the thesis): 2 cm, about the 1.5 cm the feet and the body centre of
+/// mass move apart when the body pitches by 2° at the 0.41 m body height, plus the foot radius.
+pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
+
+/// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
+/// its workspace centre, a failed leg held up at the top of its workspace.
+#[allow(clippy::too_many_arguments)]
+fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [LegKinematics; 6], workspaces: [Workspace; 6], lift: f64, dt: f64, reach: &str, given: &str) -> Result<GaitScenario> {
+    let default = RawFree::default();
+    let raw = g.free.as_ref().unwrap_or(&default);
+    let positive = |field: &str, v: Option<f64>, default: f64| -> Result<f64> {
+        let v = v.unwrap_or(default);
+        c.check(v.is_finite() && v >= dt, &format!("gait.free.{field}"), v, &format!("a duration >= the control period {dt} s"))?;
+        Ok(v)
+    };
+    let takeoff_time = positive("takeoff_s", raw.takeoff_s, DEFAULT_TAKEOFF_S)?;
+    let swing_time = positive("swing_s", raw.swing_s, DEFAULT_SWING_S)?;
+    let posture_time = positive("posture_time_s", raw.posture_time_s, DEFAULT_POSTURE_TIME_S)?;
+    let threshold = raw.landing_threshold_n.unwrap_or(THESIS_FORCE_THRESHOLD);
+    c.check(threshold.is_finite() && threshold > 0.0, "gait.free.landing_threshold_n", threshold, "a normal force > 0 N (Section 7.7: 10 N)")?;
+    let failed_leg = match raw.failed_leg {
+        None => None,
+        Some(l) => {
+            c.check((0..6).contains(&l), "gait.free.failed_leg", l as f64, "a leg number 0..5 (0, 2, 4 on the left from front to rear, 1, 3, 5 on the right), or no failed_leg")?;
+            Some(l as usize)
+        }
+    };
+    let stability_margin = raw.stability_margin_m.unwrap_or(DEFAULT_STABILITY_MARGIN_M);
+    c.check(stability_margin.is_finite() && stability_margin >= 0.0, "gait.free.stability_margin_m", stability_margin, "a distance >= 0 m")?;
+    let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, dt };
+    let footholds: [Vector3<f64>; 6] = std::array::from_fn(|l| {
+        let w = &workspaces[l];
+        if failed_leg == Some(l) {
+            w.centre_at(w.z_max)
+        } else {
+            w.centre_at(-height)
+        }
+    });
+    let joints = joints_at(&legs, &footholds)
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.to_string()))?;
+    let free_pattern = GaitPattern { name: "free".into(), beta: f64::NAN, offsets: [0.0; 6] };
+    let periodic = GaitOptions { period: f64::NAN, pattern: free_pattern, cycle: FootCycle::Plain, aep: AepMode::Omnidirectional, lift, dt };
+    let free = FreeGaitSpec { options, landing: match raw.landing {
+        LandingKind::Force => LandingSpec::Force { threshold },
+    } };
+    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs, workspaces, changes: Vec::new(), joints })
+}
+
+/// The period, the patterns, the foot cycle and the gait changes of a periodic gait.
+struct Periodic {
+    period: f64,
+    pattern: GaitPattern,
+    cycle: FootCycle,
+    aep: AepMode,
+    changes: Vec<GaitChange>,
+}
+
+/// The fields of the periodic gaits are not those of the free gait.
+fn reject_periodic_fields(g: &RawGait, c: &Ctx) -> Result<()> {
+    let written = [
+        ("period_s", g.period_s.map(|v| v.to_string())),
+        ("duty_factor", g.duty_factor.map(|v| v.to_string())),
+        ("cycle", g.cycle.map(|v| format!("{v:?}").to_lowercase())),
+        ("overlap", g.overlap.map(|v| v.to_string())),
+        ("aep", g.aep.map(|v| format!("{v:?}").to_lowercase())),
+        ("change", (!g.change.is_empty()).then(|| format!("{} changes", g.change.len()))),
+    ];
+    for (name, value) in written {
+        if let Some(v) = value {
+            return Err(c.err(&format!("gait.{name}"), v, "not a field of pattern = \"free\"", "with the free gait: clearance_m, navigation, body_height_m, [gait.heading] and [gait.free] (takeoff_s, swing_s, posture_time_s, landing, landing_threshold_n, failed_leg, stability_margin_m)"));
+        }
+    }
+    Ok(())
+}
+
+fn periodic_pattern(g: &RawGait, c: &Ctx, kind: GaitKind, dt: f64, duration: f64) -> Result<Periodic> {
+    let period_s = g.period_s.ok_or_else(|| c.err("gait.period_s", "<missing>", "missing field", format!("a leg cycle time T (s) with pattern = \"{}\"", kind_name(kind))))?;
+    // Foot cycle.
+    let cycle = match g.cycle.unwrap_or_default() {
+        CycleKind::Plain => {
+            if let Some(v) = g.overlap {
+                return Err(c.err("gait.overlap", v, "not a field of cycle = \"plain\"", "no overlap with the plain cycle (or cycle = \"enhanced\")"));
+            }
+            FootCycle::Plain
+        }
+        CycleKind::Enhanced => {
+            let overlap = g.overlap.unwrap_or(DEFAULT_OVERLAP);
+            c.check(overlap > 0.0 && overlap < 0.125, "gait.overlap", overlap, "an overlap Δφ in (0, 0.125) (cycle fraction; the takeoff, swing and landing fill 1 − β − Δφ of the cycle, so β + 4Δφ < 1 with β >= 0.5; Table 6.2: 0.05), or cycle = \"plain\"")?;
+            FootCycle::Enhanced { overlap }
+        }
+    };
+
+    // Patterns: the initial one and the changes.
+    let beta = duty_factor(c, "gait.duty_factor", kind, g.duty_factor, cycle)?;
+    let pattern = GaitPattern::of(kind, beta);
+    let mut changes = Vec::new();
+    let mut previous = 0.0;
+    for (n, ch) in g.change.iter().enumerate() {
+        let field = |name: &str| format!("gait.change[{n}].{name}");
+        c.check(ch.at_s > previous && ch.at_s < duration, &field("at_s"), ch.at_s, &format!("a time in ({previous}, {duration}) s: after the start{} and before the end of the scenario", if n > 0 { " and the previous change" } else { "" }))?;
+        previous = ch.at_s;
+        let b = duty_factor(c, &field("duty_factor"), ch.pattern, ch.duty_factor, cycle)?;
+        changes.push(GaitChange { at: ch.at_s, pattern: GaitPattern::of(ch.pattern, b) });
+    }
+    let patterns: Vec<&GaitPattern> = std::iter::once(&pattern).chain(changes.iter().map(|ch| &ch.pattern)).collect();
+
+    // Period: every swing, takeoff and landing lasts at least one control period.
+    let shortest = patterns
+        .iter()
+        .map(|p| cycle.swing_fraction(p.beta))
+        .chain((cycle.transition_fraction() > 0.0).then(|| cycle.transition_fraction()))
+        .fold(f64::INFINITY, f64::min);
+    let min_period = dt / shortest;
+    c.check(period_s >= min_period * (1.0 - 1e-9), "gait.period_s", period_s, &format!("a leg cycle time >= {min_period:.4} s, so that the swing{} each last at least one control period ({dt} s)", if cycle.transition_fraction() > 0.0 { ", the takeoff and the landing" } else { "" }))?;
+    Ok(Periodic { period: period_s, pattern, cycle, aep: g.aep.unwrap_or(AepMode::Periodic), changes })
 }
 
 fn validate_heading(h: &RawHeading, c: &Ctx, dir: &Path) -> Result<HeadingSpec> {

@@ -38,15 +38,17 @@
 //! [`TimeSeries`]: crate::robot::recorder::TimeSeries
 
 use std::path::Path;
+use std::sync::Arc;
 
 use serde::Deserialize;
 
-use crate::control::JointMotion;
+use crate::control::{GroundExperiment, JointMotion};
 use crate::description::RobotDescription;
 use crate::fields::{struct_fields, Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
+use crate::physics::Terrain;
 use crate::sim::SimError;
 
 mod drivers;
@@ -56,9 +58,10 @@ mod joint_friction;
 mod overrides;
 mod run;
 mod summary;
+mod terrain;
 
 pub use crate::control::gait::schedule::GaitChange;
-pub use gait::{GaitScenario, HeadingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
+pub use gait::{FreeGaitSpec, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
@@ -94,7 +97,7 @@ pub enum ScenarioError {
     /// cause.
     #[error("{file}: {stage} failed: {source}{hint}")]
     Simulation { file: String, stage: &'static str, source: SimError, hint: &'static str },
-    /// The settled body tilts by more than 5°: the stance cannot carry it (it rests on lifted
+    /// The settled body tilts by more than 5° from the ground below it: the stance cannot carry it (it rests on lifted
     /// legs).
     #[error("{file}: settling tips the body over (pitch {pitch_deg:.1}°, roll {roll_deg:.1}°); check that the supporting feet surround the centre of mass (initial.lifted_legs)")]
     Tipped { file: String, pitch_deg: f64, roll_deg: f64 },
@@ -136,6 +139,10 @@ pub enum ControlMode {
     /// The gait controller of Chapter 7 (`[gait]` table): heading velocities, foot references,
     /// inverse kinematics and the same 18 PI loops.
     Gait,
+    /// The ground detection experiment of Section 5.6.3 (`[ground_detection]` table): the
+    /// tested legs lowered in a sawtooth onto the ground and stopped on the detection from the
+    /// motor currents, the same 18 PI loops.
+    GroundDetection,
 }
 
 impl ControlMode {
@@ -144,13 +151,14 @@ impl ControlMode {
             ControlMode::Pi => "pi",
             ControlMode::Unpowered => "unpowered",
             ControlMode::Gait => "gait",
+            ControlMode::GroundDetection => "ground_detection",
         }
     }
 
-    /// Whether the controller tracks joint references (the PI loops of modes `pi` and `gait`),
-    /// so that references and tracking errors are recorded.
+    /// Whether the controller tracks joint references (the PI loops of modes `pi`, `gait` and
+    /// `ground_detection`), so that references and tracking errors are recorded.
     pub fn tracks_references(self) -> bool {
-        matches!(self, ControlMode::Pi | ControlMode::Gait)
+        matches!(self, ControlMode::Pi | ControlMode::Gait | ControlMode::GroundDetection)
     }
 }
 
@@ -220,6 +228,10 @@ pub struct Scenario {
     pub motions: Vec<Motion>,
     /// The walking set-up, in gait mode.
     pub gait: Option<GaitScenario>,
+    /// The ground (`[terrain]`; flat at z = 0 without it).
+    pub terrain: Arc<dyn Terrain>,
+    /// The ground detection experiment, in mode `ground_detection`.
+    pub ground_detection: Option<GroundExperiment>,
     /// The scenario file (or origin name).
     pub origin: String,
     /// The scenario text.

@@ -11,8 +11,7 @@ use std::time::Instant;
 use super::summary::{summarize, GaitStats, RunStats};
 use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
 use crate::control::gait::schedule::GaitState;
-use crate::control::{joint_pis, Controller, JointPiController, JointReferences, Unpowered};
-use crate::physics::FlatGround;
+use crate::control::{joint_pis, Controller, GroundDetector, GroundExperimentController, GroundExperimentState, JointPiController, JointReferences, Unpowered};
 use crate::robot::columns::{record_row, ColumnGroups};
 use crate::robot::model::{FrictionModel, Robot, RobotModel};
 use crate::robot::recorder::{Recorder, TimeSeries};
@@ -82,7 +81,7 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
     let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
     let mut plant = settled_robot(s)?;
     let q = plant.state().q.as_slice().to_vec();
-    let (mut controller, gait_state) = controller(s);
+    let (mut controller, Published { gait: gait_state, ground }) = controller(s);
 
     // The joint references are recorded and tracked by the PI loops in these modes.
     let pi = s.control.tracks_references();
@@ -101,7 +100,8 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
         }
         last_t = meas.t;
         if recorded {
-            record_row(&mut rec, p, meas, cmd, groups, state.as_deref());
+            let ground = ground.as_ref().map(|g| g.borrow());
+            record_row(&mut rec, p, meas, cmd, groups, state.as_deref(), ground.as_deref());
             after_row(&mut rec)?;
         }
         progress(meas.t)
@@ -122,8 +122,10 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
 /// locked (Section 6.2) unless `initial.settle` is off, then the body raised by
 /// `initial.body_height_offset`.
 pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
-    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), Arc::new(FlatGround { height: 0.0 })));
+    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), s.terrain.clone()));
     let mut q = model.touching_ground(&s.initial.joints);
+    // The attitude of the body parallel to the ground, which the settling should keep.
+    let (pitch0, roll0) = (q[4], q[5]);
     let mut qd = vec![0.0; q.len()];
     if s.initial.settle {
         let mut robot = Robot::new(model.clone());
@@ -134,7 +136,7 @@ pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
             source,
             hint: "; check that the supporting feet surround the centre of mass (initial.lifted_legs)",
         })?;
-        let (pitch, roll) = (q[4].to_degrees(), q[5].to_degrees());
+        let (pitch, roll) = ((q[4] - pitch0).to_degrees(), (q[5] - roll0).to_degrees());
         if pitch.abs() > 5.0 || roll.abs() > 5.0 {
             return Err(ScenarioError::Tipped { file: s.origin.clone(), pitch_deg: pitch, roll_deg: roll });
         }
@@ -143,20 +145,34 @@ pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
     SimulatedRobot::new(model, &q, &qd, &s.plant).map_err(|source| ScenarioError::Simulation { file: s.origin.clone(), stage: "the start", source, hint: "" })
 }
 
-/// The controller of the scenario's control mode and, walking, the state the gait controller
-/// publishes after each update.
-pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Option<Rc<RefCell<GaitState>>>) {
+/// What a scenario's controller publishes after each update, for the record.
+#[derive(Default)]
+pub(super) struct Published {
+    /// Walking: the gait controller's state.
+    pub gait: Option<Rc<RefCell<GaitState>>>,
+    /// The ground detection experiment's state.
+    pub ground: Option<Rc<RefCell<GroundExperimentState>>>,
+}
+
+/// The controller of the scenario's control mode and what it publishes.
+pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Published) {
     match s.control {
         ControlMode::Gait => {
             let g = s.gait.as_ref().expect("gait mode has a validated [gait]");
             let (controller, state) = g.controller(&s.robot);
-            (Box::new(controller), Some(state))
+            (controller, Published { gait: Some(state), ground: None })
         }
         ControlMode::Pi => {
             let pis = joint_pis(&s.robot, s.plant.period);
             let motions = s.motions.iter().map(|m| (m.joint_index(), m.motion)).collect();
-            (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), None)
+            (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), Published::default())
         }
-        ControlMode::Unpowered => (Box::new(Unpowered), None),
+        ControlMode::Unpowered => (Box::new(Unpowered), Published::default()),
+        ControlMode::GroundDetection => {
+            let e = s.ground_detection.clone().expect("ground_detection mode has a validated [ground_detection]");
+            let detector = GroundDetector::new(&s.robot, s.plant.period, e.thresholds[0]).expect("a validated description has valid leg kinematics");
+            let (controller, state) = GroundExperimentController::new(e, joint_pis(&s.robot, s.plant.period), s.initial.joints, detector);
+            (Box::new(controller), Published { gait: None, ground: Some(state) })
+        }
     }
 }

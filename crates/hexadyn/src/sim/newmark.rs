@@ -294,6 +294,26 @@ impl Newmark {
         Ok(())
     }
 
+    /// The Newton predictor of q''(t+h). Second-order coordinates: q''(t), the thesis' choice.
+    /// First-order states y = q' (bristle deflections, currents, Section 3.3.2) are fast: a
+    /// LuGre bristle relaxes to its steady deflection in well under a millisecond, against steps
+    /// of up to 10 ms. Their predictor holds the state itself, y(t+h) = y(t), i.e.
+    /// y'(t+h) = −(1 − γ)/γ · y'(t) by Eq. 3.8, instead of holding its rate: over a step much
+    /// longer than its time constant a stiff state barely moves, while its rate at t is no guide
+    /// to its rate at t+h (the rate a stiff state takes under the Newmark rule alternates in
+    /// sign from step to step). INTERPRETATION: the thesis (Eq. 3.10) does not say how the
+    /// Newton iteration is started; benches/walk: 20 % fewer residual evaluations on the 75 s
+    /// LuGre walk, the physics figures unchanged.
+    fn predict<S: System + ?Sized>(&mut self, sys: &S) {
+        let hold = -(1.0 - self.options.gamma) / self.options.gamma;
+        for (i, order) in sys.layout().orders.iter().enumerate() {
+            self.work.qdd[i] = match order {
+                Order::Second => self.state.qdd[i],
+                Order::First => hold * self.state.qdd[i],
+            };
+        }
+    }
+
     /// Newmark predictor-corrector for q(t+h), q'(t+h) from q''(t+h) (Eq. 3.7-3.8).
     fn update_kinematics(&mut self, h: f64) {
         let (b, g) = (self.options.beta, self.options.gamma);
@@ -313,8 +333,8 @@ impl Newmark {
         self.jacobian_fresh = false;
         let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, h);
         'attempt: loop {
-            // Predictor q''(t+h) = q''(t) first: a missing Jacobian is evaluated there.
-            self.work.qdd.copy_from(&self.state.qdd);
+            // Predictor (a missing Jacobian is evaluated there).
+            self.predict(sys);
             self.update_kinematics(h);
             // A step that lands on a requested instant differs from the nominal one by the
             // rounding of t_end − t (relative 1e-13 at t ~ 100 s): the factorization still fits.
@@ -360,7 +380,7 @@ impl Newmark {
             if !self.jacobian_fresh {
                 if self.work.qdd.iter().any(|x| !x.is_finite()) {
                     // The iteration blew up: evaluate the Jacobian at the predictor instead.
-                    self.work.qdd.copy_from(&self.state.qdd);
+                    self.predict(sys);
                     self.update_kinematics(h);
                 }
                 self.refresh_jacobian(sys, t_new);

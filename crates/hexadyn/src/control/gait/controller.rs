@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use super::body_motion::{BodyMotion, Pose};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
-use crate::control::{Command, Controller, DigitalPi, Measurements};
+use crate::control::{BodyPose, Command, Controller, DigitalPi, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -133,7 +133,7 @@ impl GaitController {
         let feet: Vec<Vector3<f64>> = (0..6).map(|l| self.legs_kinematics[l].foot_in_body(&joints_of(m, l))).collect();
         let pose = m.pose.map_or_else(
             || Pose { position: Vector3::new(0.0, 0.0, -feet.iter().map(|f| f.z).sum::<f64>() / 6.0), angles: Vector3::zeros() },
-            |p| Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) },
+            |p| pose_of(&p),
         );
         let htm = pose.htm();
         for l in 0..6 {
@@ -154,7 +154,7 @@ impl GaitController {
     /// The body pose the anchors are computed with: the navigation system's, or the desired
     /// one when the robot has none (it is assumed to follow its reference, Section 7.4).
     fn estimated_pose(&self, m: &Measurements, desired: &Pose) -> Htm {
-        m.pose.map_or_else(|| desired.htm(), |p| Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) }.htm())
+        estimated_pose(m, desired)
     }
 
     /// Foot lift (normal to the body plane) at local phase φ, a triangle of height `lift`: over
@@ -182,9 +182,7 @@ impl GaitController {
     fn aep(&self, leg: usize, frame: &Htm, body: &BodyMotion, heading: &Heading, z: f64) -> Vector3<f64> {
         let o = &self.options;
         let c_leg = self.workspaces[leg].centre_at(z);
-        let c_body = self.legs_kinematics[leg].to_body(&c_leg);
-        // Eq. 7.25, expressed in the leg frame.
-        let v_c = frame.rotation.transpose() * heading.point_velocity(&(body.pose.htm().rotation * c_body));
+        let v_c = centre_velocity(&self.legs_kinematics[leg], &c_leg, frame, &body.pose.htm(), heading);
         let mut aep = c_leg + v_c * (o.cycle.support_fraction(self.current_pattern().beta) * o.period / 2.0);
         aep.z = z;
         aep
@@ -271,8 +269,26 @@ pub fn steady_footholds(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], 
     })
 }
 
-fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
+/// The encoder positions (q_r, q_v, q_h) of one leg.
+pub(super) fn joints_of(m: &Measurements, leg: usize) -> Vector3<f64> {
     Vector3::new(m.positions[3 * leg], m.positions[3 * leg + 1], m.positions[3 * leg + 2])
+}
+
+/// The navigation system's body pose.
+pub(super) fn pose_of(p: &BodyPose) -> Pose {
+    Pose { position: p.position, angles: Vector3::new(p.yaw, p.pitch, p.roll) }
+}
+
+/// The body pose the anchors are computed with (Section 7.4): the navigation system's, or the
+/// desired one when the robot has none (it is assumed to follow its reference).
+pub(super) fn estimated_pose(m: &Measurements, desired: &Pose) -> Htm {
+    m.pose.map_or_else(|| desired.htm(), |p| pose_of(&p).htm())
+}
+
+/// Eq. 7.25 in the leg frame: the commanded velocity v_C/0 of the workspace centre `c_leg` (leg
+/// frame), for the leg frame `frame` = T_{0,b} T_{b,l} and the body pose `body` = T_{0,b}.
+pub(super) fn centre_velocity(kin: &LegKinematics, c_leg: &Vector3<f64>, frame: &Htm, body: &Htm, heading: &Heading) -> Vector3<f64> {
+    frame.rotation.transpose() * heading.point_velocity(&(body.rotation * kin.to_body(c_leg)))
 }
 
 impl Controller for GaitController {
@@ -426,7 +442,7 @@ mod tests {
             let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading);
             let joints = joints_at(&legs, &footholds).unwrap();
             let mut controller = GaitController::new(options, legs.clone(), workspaces, joint_pis(&d, dt), Box::new(Constant(heading)));
-            let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None };
+            let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
             let mut outside = 0.0f64;
             for k in 0..(2.0 * period / dt).round() as usize {
                 m.t = k as f64 * dt;

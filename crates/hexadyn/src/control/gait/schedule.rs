@@ -1,7 +1,8 @@
 //! A gait schedule (thesis Sections 7.1.2, 7.2.4): the [`GaitController`] with gait changes
 //! requested at given times ([`ScheduledGait`]), publishing what it did at each update in a
 //! shared [`GaitState`] (desired body pose and velocities, foot phases and references,
-//! diagnostics) that a recorder or a summary reads without reaching into the controller.
+//! diagnostics) that a recorder or a summary reads without reaching into the controller; the
+//! free gait controller publishes the same state ([`PublishedFreeGait`]).
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -10,6 +11,7 @@ use nalgebra::Vector3;
 
 use super::body_motion::Pose;
 use super::controller::{GaitController, GaitDiagnostics};
+use super::free::{FreeGaitController, FreeGaitState};
 use super::pattern::{FootPhase, GaitPattern};
 use crate::control::{Command, Controller, Measurements};
 
@@ -35,7 +37,12 @@ pub struct GaitState {
     /// Duty factor of the current pattern.
     pub beta: f64,
     pub diagnostics: GaitDiagnostics,
+    /// The free gait's posture, detections and deadlock (free gait only).
+    pub free: Option<FreeGaitState>,
 }
+
+/// Phase code of a failed leg held up (free gait), after the four of [`FootPhase::code`].
+pub const FAILED_LEG_CODE: f64 = 4.0;
 
 /// The gait controller with the scheduled gait changes, publishing its state after each update.
 pub struct ScheduledGait {
@@ -71,6 +78,41 @@ impl Controller for ScheduledGait {
             feet: c.foot_references(),
             beta: c.options.pattern.beta,
             diagnostics: c.diagnostics,
+            free: None,
+        };
+        command
+    }
+}
+
+/// The free gait controller publishing its state after each update, like [`ScheduledGait`].
+pub struct PublishedFreeGait {
+    controller: FreeGaitController,
+    state: Rc<RefCell<GaitState>>,
+}
+
+impl PublishedFreeGait {
+    pub fn new(controller: FreeGaitController) -> (Self, Rc<RefCell<GaitState>>) {
+        let state = Rc::new(RefCell::new(GaitState::default()));
+        (PublishedFreeGait { controller, state: state.clone() }, state)
+    }
+}
+
+impl Controller for PublishedFreeGait {
+    fn update(&mut self, m: &Measurements) -> Command {
+        let command = self.controller.update(m);
+        let c = &self.controller;
+        let (velocity, omega) = c.desired_velocity().unwrap_or_default();
+        let failed = c.options.failed_leg;
+        *self.state.borrow_mut() = GaitState {
+            pose: c.desired_pose().unwrap_or_default(),
+            velocity,
+            omega,
+            phases: std::array::from_fn(|l| if failed == Some(l) { FAILED_LEG_CODE } else { c.phases()[l].code() }),
+            feet: c.foot_references(),
+            // No duty factor: the free gait has no fixed pattern.
+            beta: f64::NAN,
+            diagnostics: c.diagnostics,
+            free: Some(c.state()),
         };
         command
     }

@@ -1,0 +1,397 @@
+//! The free gait controller (thesis Section 7.7, flowchart of Fig. 7.29): heading velocities →
+//! posture on each new touchdown (Rule 1, [`super::posture`]) → corrected global velocities
+//! ([`super::velocity`]) → desired body HTM (Eq. 7.12-7.23) → foot references by leg state
+//! (support: anchors, Eq. 7.11; takeoff, swing to the AEP of maximum kinematic margin, landing
+//! until the ground is detected) → inverse kinematics (Eq. 7.7) → 18 digital PI → then Rules 2
+//! and 3 choose the legs that lift ([`super::rules`]) and the deadlock condition halts the
+//! support legs (Section 7.7.4).
+//!
+//! Like the periodic [`GaitController`](crate::control::gait::controller::GaitController) it sees
+//! only the measurements (and the navigation system's pose when there is one); the landing
+//! detector decides from the measurements too ([`super::landing`]).
+
+use nalgebra::{Vector2, Vector3};
+
+use super::landing::LandingDetector;
+use super::posture::{ground_plane, solve_posture, PostureCorrection};
+use super::rules::{deadlocked, neighbours, stability_margin, swing_candidates};
+use super::velocity::corrected_velocities;
+use crate::control::gait::body_motion::{BodyMotion, Pose};
+use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
+use crate::control::gait::heading::{Heading, HeadingSource};
+use crate::control::gait::pattern::FootPhase;
+use crate::control::{Command, Controller, DigitalPi, Measurements};
+use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::spatial::Htm;
+
+/// Security margin of the AEP inside the workspace boundary (m).
+///
+/// INTERPRETATION: Section 7.1.1 restricts the working volume "for a degree of security"
+/// without a figure. The anchor of a new support is where the encoders put the foot seen from
+/// the estimated body pose, while its reference is computed from the desired pose (Eq. 7.11):
+/// the difference, the body's tracking error, moves the support foot reference. On the 20°
+/// slope that error reaches about 1 cm (and the horizontal joints' tracking error about 6 mm),
+/// and a foot landing on the boundary starts its support outside its workspace, lifts again at
+/// once (lowest margin, Rule 3) and keeps a neighbour at its boundary deadlocked. 1 cm.
+pub const AEP_SECURITY: f64 = 0.01;
+
+/// Parameters of the free gait.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FreeGaitOptions {
+    /// Height of the body frame above the ground in the well-conditioned posture (m): the feet
+    /// at z = −body_height in their leg frames, the references p_z,C/b of Eq. 7.32.
+    pub body_height: f64,
+    /// Rise of the foot during the takeoff (m), kept through the swing (Section 7.7.3: "the
+    /// takeoff has given a foot clearance high enough to avoid obstacles").
+    pub lift: f64,
+    /// Duration of the takeoff (s); the landing descends at the same speed lift / takeoff_time.
+    pub takeoff_time: f64,
+    /// Duration of the swing, the constant denominator of Eq. 7.31 (3 s in Section 7.7.3).
+    pub swing_time: f64,
+    /// t_post of Eq. 7.35-7.37 (2 s for AMRU5).
+    pub posture_time: f64,
+    /// A failed leg, held up (beyond the thesis: the rules extend to five legs).
+    pub failed_leg: Option<usize>,
+    /// Smallest static stability margin (m) that the feet left in support must keep when a leg
+    /// lifts, with a failed leg (six legs follow Rules 2 and 3 alone, as in the thesis).
+    pub stability_margin: f64,
+    /// Control period Δt (s).
+    pub dt: f64,
+}
+
+/// The state of one leg.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Leg {
+    phase: FootPhase,
+    /// Anchor {p_F/0}_0 of the support (Eq. 7.10); in the air, the last contact point (used by
+    /// Eq. 7.32); during the landing, the virtual anchor of the descending foot.
+    anchor: Vector3<f64>,
+    /// Last contact point (global), for the posture of the legs in the air.
+    contact: Vector3<f64>,
+    /// Time spent in the current phase (s).
+    elapsed: f64,
+    /// Foot reference (leg frame) at the start of the swing, p_PEP,takeoff of Eq. 7.31.
+    pep: Vector3<f64>,
+    /// Current foot reference (leg frame) and joint references.
+    foot: Vector3<f64>,
+    joints: Vector3<f64>,
+}
+
+/// What the free gait did at its last update, for the results columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FreeGaitState {
+    /// Height of the body above the ground plane estimated from the contact points (m).
+    pub clearance: f64,
+    /// Roll and pitch of the body as the controller knows them (rad): the navigation system's,
+    /// else the desired ones.
+    pub roll: f64,
+    pub pitch: f64,
+    /// Legs whose landing was detected at this update.
+    pub touchdowns: [bool; 6],
+    /// The support legs are halted (Section 7.7.4).
+    pub deadlock: bool,
+    /// Posture computations (Rule 1) so far.
+    pub postures: usize,
+    /// Instants spent deadlocked so far.
+    pub deadlocked_periods: usize,
+}
+
+/// The free gait controller of Section 7.7.
+pub struct FreeGaitController {
+    pub options: FreeGaitOptions,
+    legs_kinematics: [LegKinematics; 6],
+    workspaces: [Workspace; 6],
+    pis: [DigitalPi; JOINTS],
+    heading: Box<dyn HeadingSource>,
+    landing: Box<dyn LandingDetector>,
+    neighbours: [Option<(usize, usize)>; 6],
+    body: Option<BodyMotion>,
+    legs: [Leg; 6],
+    /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
+    posture: (Vector3<f64>, f64),
+    state: FreeGaitState,
+    pub diagnostics: GaitDiagnostics,
+}
+
+impl FreeGaitController {
+    pub fn new(
+        options: FreeGaitOptions,
+        legs: [LegKinematics; 6],
+        workspaces: [Workspace; 6],
+        pis: [DigitalPi; JOINTS],
+        heading: Box<dyn HeadingSource>,
+        landing: Box<dyn LandingDetector>,
+    ) -> Self {
+        let z = Vector3::zeros();
+        let idle = Leg { phase: FootPhase::Support, anchor: z, contact: z, elapsed: 0.0, pep: z, foot: z, joints: z };
+        let neighbours = neighbours(options.failed_leg);
+        FreeGaitController {
+            options,
+            legs_kinematics: legs,
+            workspaces,
+            pis,
+            heading,
+            landing,
+            neighbours,
+            body: None,
+            legs: [idle; 6],
+            posture: (z, f64::NEG_INFINITY),
+            state: FreeGaitState::default(),
+            diagnostics: GaitDiagnostics::default(),
+        }
+    }
+
+    pub fn phases(&self) -> [FootPhase; 6] {
+        self.legs.map(|l| l.phase)
+    }
+    pub fn desired_pose(&self) -> Option<Pose> {
+        self.body.as_ref().map(|b| b.pose)
+    }
+    pub fn desired_velocity(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        self.body.as_ref().map(|b| (b.velocity(), b.omega()))
+    }
+    pub fn foot_references(&self) -> [Vector3<f64>; 6] {
+        self.legs.map(|l| l.foot)
+    }
+    pub fn state(&self) -> FreeGaitState {
+        self.state
+    }
+
+    fn working(&self, leg: usize) -> bool {
+        self.options.failed_leg != Some(leg)
+    }
+
+    fn leg_frame(&self, leg: usize, body: &Htm) -> Htm {
+        body.compose(&self.legs_kinematics[leg].body_from_leg())
+    }
+
+    /// Where a failed leg is held: its workspace centre at the top of the workspace, the height
+    /// of a foot in the air.
+    fn held_up(&self, leg: usize) -> Vector3<f64> {
+        let w = &self.workspaces[leg];
+        w.centre_at(w.z_max)
+    }
+
+    /// First update: the body pose (navigation, or level with the body frame at the mean foot
+    /// height) and an anchor under every working foot, where the encoders put it.
+    fn start(&mut self, m: &Measurements) {
+        let working: Vec<usize> = (0..6).filter(|&l| self.working(l)).collect();
+        let mean_z = working.iter().map(|&l| self.legs_kinematics[l].foot_in_body(&joints_of(m, l)).z).sum::<f64>() / working.len() as f64;
+        let pose = m.pose.map_or_else(|| Pose { position: Vector3::new(0.0, 0.0, -mean_z), angles: Vector3::zeros() }, |p| pose_of(&p));
+        let htm = pose.htm();
+        for l in 0..6 {
+            let q = joints_of(m, l);
+            let foot = self.legs_kinematics[l].foot(&q);
+            let anchor = self.leg_frame(l, &htm).apply(&foot);
+            let phase = if self.working(l) { FootPhase::Support } else { FootPhase::Swing };
+            self.legs[l] = Leg { phase, anchor, contact: anchor, elapsed: 0.0, pep: foot, foot, joints: q };
+        }
+        self.body = Some(BodyMotion::new(pose));
+    }
+
+    /// Rule 1 (Eq. 7.32-7.37): the posture that puts the last contact points of the working
+    /// legs (seen from the estimated body pose) closest to their references, as body velocities
+    /// over t_post from now.
+    fn compute_posture(&mut self, estimated: &Htm, t: f64) {
+        let to_body = estimated.inverse();
+        let (mut p0, mut reference) = (Vec::with_capacity(6), Vec::with_capacity(6));
+        for l in (0..6).filter(|&l| self.working(l)) {
+            p0.push(to_body.apply(&self.legs[l].contact));
+            let kin = &self.legs_kinematics[l];
+            reference.push(kin.to_body(&self.workspaces[l].centre_at(-self.options.body_height)).z);
+        }
+        // The simplex does not fail on finite inputs; if it ever did, the posture is kept.
+        let c = solve_posture(&p0, &reference).unwrap_or(PostureCorrection::default());
+        let (vz, wx, wy) = c.velocities(self.options.posture_time);
+        self.posture = (Vector3::new(vz, wx, wy), t + self.options.posture_time);
+        self.state.postures += 1;
+    }
+
+    /// The AEP of maximum kinematic margin (Section 7.7.3, from Eq. 7.24): the point of the
+    /// workspace from which the foot, moving at −v_C in support, travels the longest before the
+    /// boundary, i.e. C + v̂_C R (leg frame, horizontal).
+    ///
+    /// INTERPRETATION: the foot touches down after its landing, which carries it with the
+    /// support motion for about the takeoff time; the AEP is set back by that distance,
+    /// |v_C| t_takeoff, and by the security margin of the constrained working volume (Section
+    /// 7.1.1, [`AEP_SECURITY`]), so that the touchdown is inside the boundary and not beyond it.
+    fn aep(&self, leg: usize, v_c: &Vector3<f64>, z: f64) -> Vector3<f64> {
+        let w = &self.workspaces[leg];
+        let v = Vector3::new(v_c.x, v_c.y, 0.0);
+        let speed = v.norm();
+        let mut aep = w.centre_at(z);
+        if speed > 0.0 {
+            aep += v * ((w.radius - speed * self.options.takeoff_time - AEP_SECURITY).max(0.0) / speed);
+        }
+        aep
+    }
+
+    /// Kinematic margin (Section 7.7.3) of the foot at `p` moving at −v_C in its leg frame:
+    /// the horizontal distance to the side of the workspace cylinder.
+    ///
+    /// INTERPRETATION: on uneven ground the feet leave the cylinder's height range (its caps
+    /// bound the foot heights on flat ground); the posture control keeps the heights, and the
+    /// margin that selects the swing and the deadlock is the horizontal one, "the remaining
+    /// distance to travel (in the direction of the robot motion)".
+    fn margin(&self, leg: usize, p: &Vector3<f64>, v_c: &Vector3<f64>) -> f64 {
+        let w = &self.workspaces[leg];
+        let level = Vector3::new(p.x, p.y, p.z.clamp(w.z_min, w.z_max));
+        w.margin(&level, &Vector3::new(-v_c.x, -v_c.y, 0.0))
+    }
+
+    /// The legs that lift now among the Rule 2-3 candidates: all of them with six legs; with a
+    /// failed leg, in order of increasing margin, those whose lift leaves the body centre inside
+    /// the support polygon by at least the stability margin.
+    fn lifting(&self, candidates: [bool; 6], margins: &[f64; 6], estimated: &Htm) -> [bool; 6] {
+        if self.options.failed_leg.is_none() {
+            return candidates;
+        }
+        let mut order: Vec<usize> = (0..6).filter(|&l| candidates[l]).collect();
+        order.sort_by(|&a, &b| margins[a].total_cmp(&margins[b]));
+        let mut support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.legs[l].phase == FootPhase::Support);
+        let centre = estimated.translation.xy();
+        let mut lifting = [false; 6];
+        for l in order {
+            support[l] = false;
+            let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.legs[k].anchor.xy()).collect();
+            if stability_margin(&centre, &feet) >= self.options.stability_margin {
+                lifting[l] = true;
+            } else {
+                support[l] = true;
+            }
+        }
+        lifting
+    }
+}
+
+impl Controller for FreeGaitController {
+    fn update(&mut self, m: &Measurements) -> Command {
+        let o = self.options.clone();
+        let h: Heading = self.heading.heading(m.t);
+        let first = self.body.is_none();
+        if first {
+            self.start(m);
+        }
+        let contact = self.landing.ground_contact(m);
+        let before = self.body.as_ref().expect("started").pose;
+        let estimated = estimated_pose(m, &before);
+
+        // Landings detected: the support begins where the encoders put the foot (Section 7.4).
+        self.state.touchdowns = [false; 6];
+        for l in 0..6 {
+            if self.legs[l].phase == FootPhase::Landing && contact[l] {
+                let measured = self.leg_frame(l, &estimated).apply(&self.legs_kinematics[l].foot(&joints_of(m, l)));
+                let leg = &mut self.legs[l];
+                (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured, measured, 0.0);
+                self.state.touchdowns[l] = true;
+            }
+        }
+        // Rule 1: the posture when a new leg touches the ground (and at the start).
+        if first || self.state.touchdowns.iter().any(|&t| t) {
+            self.compute_posture(&estimated, m.t);
+        }
+
+        // Section 7.7.2: the corrected global velocities; zero while deadlocked (Section 7.7.4).
+        let rotation = before.htm().rotation;
+        let (v_b, omega_b) = if self.state.deadlock {
+            (Vector3::zeros(), Vector3::zeros())
+        } else {
+            let (local, until) = self.posture;
+            let local = if m.t < until - 0.5 * o.dt { local } else { Vector3::zeros() };
+            let n = rotation * Vector3::z();
+            let v_post = n * local.x;
+            let omega_post = rotation * Vector3::new(local.y, local.z, 0.0);
+            corrected_velocities(&h.velocity, &Vector3::new(0.0, 0.0, h.yaw_rate), &v_post, &omega_post, &n)
+        };
+        if !first {
+            // Eq. 7.12-7.23.
+            self.body.as_mut().expect("started").step(v_b, omega_b, o.dt);
+        }
+        let body = self.body.clone().expect("started");
+        let desired = body.pose.htm();
+        let estimated = estimated_pose(m, &body.pose);
+
+        let landing_speed = o.lift / o.takeoff_time;
+        let mut references = [0.0; JOINTS];
+        let mut margins = [f64::INFINITY; 6];
+        let mut speed_max = 0.0f64;
+        for l in 0..6 {
+            let mut leg = self.legs[l];
+            let frame_desired = self.leg_frame(l, &desired);
+            let c = self.workspaces[l].centre_at(-o.body_height);
+            let v_c = centre_velocity(&self.legs_kinematics[l], &c, &frame_desired, &desired, &h);
+            leg.elapsed += o.dt;
+            leg.foot = if !self.working(l) {
+                self.held_up(l)
+            } else {
+                match leg.phase {
+                    // Eq. 7.11.
+                    FootPhase::Support => frame_desired.inverse().apply(&leg.anchor),
+                    // Lifted at constant speed with the support's horizontal motion.
+                    FootPhase::Takeoff => {
+                        let mut p = frame_desired.inverse().apply(&leg.anchor);
+                        p.z += landing_speed * leg.elapsed.min(o.takeoff_time);
+                        if leg.elapsed >= o.takeoff_time - 0.5 * o.dt {
+                            (leg.phase, leg.elapsed, leg.pep) = (FootPhase::Swing, 0.0, p);
+                        }
+                        p
+                    }
+                    // Eq. 7.31 with the constant swing time and the AEP recomputed at every
+                    // step; the foot height stays that of the end of the takeoff.
+                    FootPhase::Swing => {
+                        let aep = self.aep(l, &v_c, leg.pep.z);
+                        let v = (aep - leg.pep) / o.swing_time;
+                        let mut p = leg.foot + Vector3::new(v.x, v.y, 0.0) * o.dt;
+                        p.z = leg.pep.z;
+                        if leg.elapsed >= o.swing_time - 0.5 * o.dt {
+                            // The landing: a virtual anchor where the foot is, so that the support
+                            // algorithm runs while the foot descends (Section 7.6).
+                            (leg.phase, leg.elapsed) = (FootPhase::Landing, 0.0);
+                            leg.anchor = self.leg_frame(l, &estimated).apply(&p);
+                        }
+                        p
+                    }
+                    // Down at constant speed until the ground is detected.
+                    FootPhase::Landing => {
+                        let mut p = frame_desired.inverse().apply(&leg.anchor);
+                        p.z -= landing_speed * leg.elapsed;
+                        p
+                    }
+                }
+            };
+            if self.working(l) && leg.phase == FootPhase::Support {
+                margins[l] = self.margin(l, &leg.foot, &v_c);
+                speed_max = speed_max.max(v_c.xy().norm());
+            }
+            // Eq. 7.7 from the previous references.
+            let ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
+            if !ik.is_reached() {
+                self.diagnostics.clamped_references += 1;
+                self.diagnostics.last_clamped_at = Some(m.t);
+            }
+            leg.joints = ik.joints;
+            references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
+            self.legs[l] = leg;
+        }
+
+        // Rules 2 and 3, and the deadlock condition (Section 7.7.4).
+        let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.legs[l].phase == FootPhase::Support);
+        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours), &margins, &estimated);
+        for l in (0..6).filter(|&l| lifting[l]) {
+            let leg = &mut self.legs[l];
+            (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);
+        }
+        self.state.deadlock = deadlocked(&support, &margins, &lifting, speed_max * o.dt);
+        self.state.deadlocked_periods += usize::from(self.state.deadlock);
+
+        // The posture as the controller knows it.
+        let to_body = estimated.inverse();
+        let contacts: Vec<Vector3<f64>> = (0..6).filter(|&l| self.working(l)).map(|l| to_body.apply(&self.legs[l].contact)).collect();
+        self.state.clearance = ground_plane(&contacts).map_or(f64::NAN, |(height, _)| height);
+        let angles = m.pose.map_or(body.pose.angles, |p| pose_of(&p).angles);
+        (self.state.pitch, self.state.roll) = (angles.y, angles.z);
+
+        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
+        Command { voltages, references }
+    }
+}

@@ -1,0 +1,190 @@
+//! The free gait on the ideal plant (the joints are their references, the body follows its
+//! desired pose, flat ground at z = 0): the kinematic level of Section 7.7.3's rules.
+
+use nalgebra::Vector3;
+use rand::Rng;
+
+use super::*;
+use crate::control::gait::controller::joints_at;
+use crate::control::gait::heading::{Constant, Heading};
+use crate::control::gait::pattern::FootPhase;
+use crate::control::{joint_pis, Controller, Measurements};
+use crate::description::RobotDescription;
+use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::test_util::rng;
+
+struct Setup {
+    legs: [LegKinematics; 6],
+    workspaces: [Workspace; 6],
+    height: f64,
+    description: RobotDescription,
+}
+
+fn setup() -> Setup {
+    let description = RobotDescription::amru5();
+    let legs = LegKinematics::hexapod_from_description(&description).unwrap();
+    let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
+    let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, 0.045).unwrap());
+    Setup { legs, workspaces, height, description }
+}
+
+fn options(s: &Setup, dt: f64, failed_leg: Option<usize>) -> FreeGaitOptions {
+    FreeGaitOptions { body_height: s.height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg, stability_margin: 0.02, dt }
+}
+
+/// The ideal plant: joints = references, the body where the controller wants it, a foot on the
+/// ground (z <= 0) carries 100 N.
+fn run(c: &mut FreeGaitController, joints: [f64; JOINTS], s: &Setup, dt: f64, duration: f64, mut each: impl FnMut(&FreeGaitController, f64) -> bool) {
+    let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: Some([100.0; 6]) };
+    for k in 0..(duration / dt).round() as usize {
+        m.t = k as f64 * dt;
+        let command = c.update(&m);
+        if !each(c, m.t) {
+            return;
+        }
+        m.positions = command.references;
+        let body = c.desired_pose().unwrap().htm();
+        m.foot_normal_forces = Some(std::array::from_fn(|l| {
+            let q = Vector3::new(m.positions[3 * l], m.positions[3 * l + 1], m.positions[3 * l + 2]);
+            let z = body.compose(&s.legs[l].body_from_leg()).apply(&s.legs[l].foot(&q)).z;
+            if z <= 1e-9 { 100.0 } else { 0.0 }
+        }));
+    }
+}
+
+fn controller(s: &Setup, options: FreeGaitOptions, heading: Heading) -> FreeGaitController {
+    let pis = joint_pis(&s.description, options.dt);
+    FreeGaitController::new(options, s.legs.clone(), s.workspaces, pis, Box::new(Constant(heading)), Box::new(NormalForce { threshold: THESIS_FORCE_THRESHOLD }))
+}
+
+/// Section 7.7.3: "The combination of these two criteria converges to a tripod gait on flat
+/// ground in most of the cases, and sometimes to a forward wave gait." From 1000 random
+/// postures (every foot uniformly in its workspace disc on the ground) and random walking
+/// directions at 1 cm/s, (a) every start settles within its first 10 steps (a step: the legs
+/// that lift together) into a periodic gait in which every leg lifts equally often, with no
+/// deadlock that does not clear, and (b) most of them (more than half, the thesis' "most of the
+/// cases") into the alternating tripods {0, 3, 4}, {1, 2, 5}.
+///
+/// The issue's target of 95 % tripods is NOT met by Rules 2 and 3 as the thesis states them
+/// (measured: 56.5 %): the rest settle into wave gaits that lift two legs at a time (e.g.
+/// {0, 5}, {2, 3}, {1, 4}) or one, which the rules keep stable (the legs left in support always have
+/// a neighbour with a lower margin). The thesis cites [PORT04] for extra priorities that make
+/// the tripod the only attractor; they are not implemented.
+#[test]
+fn rules_2_and_3_settle_into_a_periodic_gait_mostly_a_tripod() {
+    let s = setup();
+    let dt = 0.05;
+    let mut r = rng(11);
+    let (cases, mut tripod, mut periodic) = (1000, 0, 0);
+    let tripods = [[true, false, false, true, true, false], [false, true, true, false, false, true]];
+    for _ in 0..cases {
+        let feet: [Vector3<f64>; 6] = std::array::from_fn(|l| {
+            let w = &s.workspaces[l];
+            let (rho, a) = (w.radius * r.random_range(0.0f64..1.0).sqrt(), r.random_range(0.0..std::f64::consts::TAU));
+            w.centre_at(-s.height) + Vector3::new(rho * a.cos(), rho * a.sin(), 0.0)
+        });
+        let direction = r.random_range(0.0..std::f64::consts::TAU);
+        let heading = Heading::new(0.01 * direction.cos(), 0.01 * direction.sin(), 0.0);
+        let mut c = controller(&s, options(&s, dt, None), heading);
+        let mut steps: Vec<[bool; 6]> = Vec::new();
+        let mut previous = [FootPhase::Support; 6];
+        run(&mut c, joints_at(&s.legs, &feet).unwrap(), &s, dt, 400.0, |c, _| {
+            let phases = c.phases();
+            let lifted: [bool; 6] = std::array::from_fn(|l| phases[l] == FootPhase::Takeoff && previous[l] != FootPhase::Takeoff);
+            if lifted.iter().any(|&x| x) {
+                steps.push(lifted);
+            }
+            previous = phases;
+            steps.len() < 24
+        });
+        assert_eq!(steps.len(), 24, "a start that stops stepping (permanent deadlock)");
+        // Settled at step i < 10 into a cycle of p steps: the steps repeat with period p to the
+        // end, and every leg lifts as often as the others in a cycle.
+        let settles = |i: usize, p: usize| {
+            let count = |l: usize| (i..i + p).filter(|&j| steps[j][l]).count();
+            let even = count(0) > 0 && (1..6).all(|l| count(l) == count(0));
+            even && (i..steps.len() - p).all(|j| steps[j] == steps[j + p])
+        };
+        let is_tripod = (0..10).any(|i| tripods.contains(&steps[i]) && settles(i, 2));
+        let is_periodic = (0..10).any(|i| [2, 3, 6].iter().any(|&p| settles(i, p)));
+        tripod += usize::from(is_tripod);
+        periodic += usize::from(is_periodic);
+        if !is_periodic {
+            let names: Vec<String> = steps.iter().map(|st| (0..6).filter(|&l| st[l]).map(|l| l.to_string()).collect::<String>()).collect();
+            println!("not periodic: direction {direction:.2}: {names:?}");
+        }
+    }
+    println!("Rules 2-3: {tripod}/{cases} random starts settle into a tripod within 10 steps, {periodic}/{cases} into a periodic gait");
+    assert_eq!(periodic, cases);
+    assert!(2 * tripod > cases, "{tripod}");
+}
+
+/// Section 7.7.4, a constructed deadlock: leg 1 lifts first (lowest margin); leg 0, its
+/// neighbour, reaches its workspace boundary while leg 1 is in the air and cannot lift (Rule 2).
+/// The support legs halt (body and support foot references frozen) while leg 1 finishes its
+/// swing and landing; when it is down, leg 0 lifts, the deadlock clears and the body walks on.
+/// Leg 0's foot never overruns its workspace by more than one control step.
+#[test]
+fn deadlock_halts_the_support_legs_until_it_clears() {
+    let s = setup();
+    let dt = 0.01;
+    let v = 0.01;
+    let feet: [Vector3<f64>; 6] = std::array::from_fn(|l| {
+        let w = &s.workspaces[l];
+        // The foot moves along −x in every leg frame rotated by −α: put legs 0 and 1 back
+        // along their motion.
+        let back = match l {
+            0 => 0.7,
+            1 => 0.8,
+            _ => 0.0,
+        };
+        let motion = s.legs[l].direction_to_leg(&Vector3::new(-1.0, 0.0, 0.0));
+        w.centre_at(-s.height) + motion * (back * w.radius)
+    });
+    let mut c = controller(&s, options(&s, dt, None), Heading::new(v, 0.0, 0.0));
+    let (mut started, mut cleared, mut halted_steps) = (None, None, 0usize);
+    let mut last: Option<(Vector3<f64>, [Vector3<f64>; 6], [FootPhase; 6])> = None;
+    // Consecutive instants deadlocked before this one: the body halts from the second (the
+    // first step after the deadlock still integrates the last velocity by the trapezoidal rule).
+    let mut halted_before = 0usize;
+    let mut worst_overrun = 0.0f64;
+    let mut leg1_moved_while_halted = false;
+    run(&mut c, joints_at(&s.legs, &feet).unwrap(), &s, dt, 30.0, |c, t| {
+        let state = c.state();
+        let pose = c.desired_pose().unwrap().position;
+        let refs = c.foot_references();
+        let phases = c.phases();
+        if phases[0] == FootPhase::Support {
+            worst_overrun = worst_overrun.max(s.workspaces[0].distance_outside(&Vector3::new(refs[0].x, refs[0].y, s.workspaces[0].z_min)));
+        }
+        if let Some((p, r, ph)) = &last {
+            if halted_before >= 2 {
+                halted_steps += 1;
+                assert!((pose - p).norm() < 1e-12, "the body moves while deadlocked at t = {t}");
+                for l in (0..6).filter(|&l| ph[l] == FootPhase::Support && phases[l] == FootPhase::Support) {
+                    assert!((refs[l] - r[l]).norm() < 1e-12, "support leg {l} moves while deadlocked at t = {t}");
+                }
+                leg1_moved_while_halted |= (refs[1] - r[1]).norm() > 1e-9;
+            }
+        }
+        if state.deadlock && started.is_none() {
+            started = Some(t);
+            assert_eq!(phases[0], FootPhase::Support);
+            assert_ne!(phases[1], FootPhase::Support);
+        }
+        if started.is_some() && !state.deadlock && cleared.is_none() {
+            cleared = Some(t);
+            assert_eq!(phases[1], FootPhase::Support, "leg 1 down");
+            assert_eq!(phases[0], FootPhase::Takeoff, "leg 0 lifts");
+        }
+        last = Some((pose, refs, phases));
+        halted_before = if state.deadlock { halted_before + 1 } else { 0 };
+        true
+    });
+    let (started, cleared) = (started.expect("a deadlock"), cleared.expect("the deadlock clears"));
+    println!("deadlock from {started:.2} s to {cleared:.2} s ({halted_steps} halted control periods), leg 0 overran its workspace by {worst_overrun:.2e} m");
+    assert!(halted_steps > 50 && leg1_moved_while_halted);
+    assert!(worst_overrun <= v * dt + 1e-12);
+    // Walking resumed: the body moved on after the deadlock.
+    assert!(c.desired_pose().unwrap().position.x > v * (30.0 - (cleared - started)) * 0.9 - 1e-3);
+}

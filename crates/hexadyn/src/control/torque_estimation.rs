@@ -1,0 +1,127 @@
+//! Model-based estimation of the joint torques, thesis Section 5.6.2 and Fig. 5.12: from the
+//! encoder positions, numerical derivatives behind a 3 Hz low-pass filter, a dry/viscous friction
+//! model (Eq. 6.1 with the unloaded parameters of Table 5.3) and the inertia and gravity of the
+//! legs by the virtual power principle (Eq. 3.37); against it, the joint torque measured from the
+//! motor current (Eq. 5.17 and 3.90: τ = n k_t i), filtered at 3 Hz as well. Their difference
+//! is the torque of the ground contact, Eq. 5.16: τ − τ̂ ≈ τ_gnd.
+//!
+//! It reads sensor values only ([`Measurements`]: encoder positions, currents and, when a
+//! navigation system is present, the body attitude for the direction of gravity).
+//!
+//! INTERPRETATION: Fig. 5.12 is lost; the text places the 3 Hz filter "at the input" of the
+//! positions and also on the current. Both are filtered here with the same filter, so that the
+//! measured and the estimated torques carry the same lag. Velocities and accelerations are
+//! backward differences of the filtered positions (the z⁻¹ of Fig. 5.12). The leg model is that
+//! of the robot description (Eq. 3.37 on the multibody model of the hexapod) with the body at
+//! rest: level, or at the attitude the navigation system reports.
+
+use super::interface::Measurements;
+use super::low_pass::DigitalLowPass;
+use crate::description::RobotDescription;
+use crate::hexapod::{Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
+use crate::mbs::{self, Data};
+use crate::physics::DryViscous;
+
+/// The joint torques of one control instant (Nm for q_r, N for q_v and q_h), per joint
+/// k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TorqueEstimate {
+    /// Filtered positions q̂ and their backward differences q̂', q̂''.
+    pub q: [f64; JOINTS],
+    pub qd: [f64; JOINTS],
+    pub qdd: [f64; JOINTS],
+    /// τ = n k_t i from the filtered current (Eq. 5.17).
+    pub measured: [f64; JOINTS],
+    /// τ̂ = τ̂_iner + τ̂_grav + τ̂_fric (Eq. 5.14).
+    pub estimated: [f64; JOINTS],
+    /// τ̂_fric, part of `estimated`.
+    pub friction: [f64; JOINTS],
+}
+
+impl TorqueEstimate {
+    /// τ − τ̂ ≈ τ_gnd of joint k (Eq. 5.16).
+    pub fn ground(&self, k: usize) -> f64 {
+        self.measured[k] - self.estimated[k]
+    }
+}
+
+/// The torque estimator of Fig. 5.12 for the 18 joints.
+#[derive(Clone, Debug)]
+pub struct TorqueEstimator {
+    mechanics: Mechanics,
+    data: Data,
+    friction: [DryViscous; JOINTS],
+    /// n k_t per joint (Eq. 5.17).
+    torque_per_ampere: [f64; JOINTS],
+    dt: f64,
+    positions: [DigitalLowPass; JOINTS],
+    currents: [DigitalLowPass; JOINTS],
+    estimate: Option<TorqueEstimate>,
+    coordinates: [[f64; DOF]; 3],
+    residual: [f64; DOF],
+}
+
+impl TorqueEstimator {
+    /// The estimator of a robot description at the control period `dt` with the filter
+    /// cut-off `cutoff_hz` (3 Hz on AMRU5, [`super::DIGITAL_CUTOFF_HZ`]).
+    pub fn new(d: &RobotDescription, dt: f64, cutoff_hz: f64) -> Self {
+        let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
+        let data = Data::new(&mechanics.model);
+        // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters of Table 5.3.
+        let friction = std::array::from_fn(|k| d.friction(k / 3, Joint::ALL[k % 3]).dry_viscous());
+        TorqueEstimator {
+            mechanics,
+            data,
+            friction,
+            torque_per_ampere: std::array::from_fn(|k| d.joint_torque_per_ampere(Joint::ALL[k % 3])),
+            dt,
+            positions: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
+            currents: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
+            estimate: None,
+            coordinates: [[0.0; DOF]; 3],
+            residual: [0.0; DOF],
+        }
+    }
+
+    /// The estimate of the last update.
+    pub fn estimate(&self) -> Option<&TorqueEstimate> {
+        self.estimate.as_ref()
+    }
+
+    /// One control period: filters the measurements, differentiates, and evaluates Eq. 5.14.
+    pub fn update(&mut self, m: &Measurements) -> &TorqueEstimate {
+        let previous = self.estimate.take();
+        let mut e = TorqueEstimate::default();
+        for k in 0..JOINTS {
+            e.q[k] = self.positions[k].update(m.positions[k]);
+            e.measured[k] = self.torque_per_ampere[k] * self.currents[k].update(m.currents[k]);
+            if let Some(p) = &previous {
+                e.qd[k] = (e.q[k] - p.q[k]) / self.dt;
+                e.qdd[k] = (e.qd[k] - p.qd[k]) / self.dt;
+            }
+            e.friction[k] = self.friction[k].torque(e.qd[k]).0;
+        }
+        self.inertia_and_gravity(m, &mut e);
+        self.estimate = Some(e);
+        self.estimate.as_ref().expect("just set")
+    }
+
+    /// τ̂_iner + τ̂_grav added to τ̂_fric into `e.estimated`: the joint rows of the residual
+    /// M q̈ + h − g of Eq. 3.37 with no applied force but gravity and the body at rest.
+    fn inertia_and_gravity(&mut self, m: &Measurements, e: &mut TorqueEstimate) {
+        let [q, qd, qdd] = &mut self.coordinates;
+        if let Some(pose) = &m.pose {
+            (q[4], q[5]) = (pose.pitch, pose.roll);
+        }
+        q[6..].copy_from_slice(&e.q);
+        qd[6..].copy_from_slice(&e.qd);
+        qdd[6..].copy_from_slice(&e.qdd);
+        let model = &self.mechanics.model;
+        mbs::relative_kinematics(model, &mut self.data, q, qd);
+        self.data.clear_forces();
+        mbs::residual(model, &mut self.data, qdd, &mut self.residual);
+        for k in 0..JOINTS {
+            e.estimated[k] = self.residual[6 + k] + e.friction[k];
+        }
+    }
+}

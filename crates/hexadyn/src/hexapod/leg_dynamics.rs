@@ -1,0 +1,168 @@
+//! The joint torques one leg needs on a still, level body: the gravity, inertia, Coriolis and
+//! centrifugal terms of Eq. 3.37 applied to a single leg model (τ_grav + τ_iner of Eq. 5.14).
+//! The friction identification removes τ_grav from the measured motor torques (Section 5.2.1,
+//! Eq. 5.7) and the ground detection estimates both (Section 5.6.2, Fig. 5.12).
+
+use super::{joint_index, Mechanics, DOF, LEG_COUNT};
+use nalgebra::Vector3;
+
+use crate::mbs::{relative_kinematics, residual, Data};
+
+/// The generalized forces (Nm for q_r, N for q_v and q_h) the motors of `leg` must apply for
+/// the leg to follow (q, q', q'') = (`q`, `qd`, `qdd`) with the body at rest and level and the
+/// force `foot_force` (global frame, N) on the foot: the leg's rows of the multibody residual (Eq. 3.37, 3.38) without applied
+/// joint forces. The rotors are part of the leg (their inertia counts in q''). Every leg is put
+/// in the same configuration (a closed pantograph needs a valid one), which does not change
+/// the rows of `leg`: with the body still, a leg's rows see only its own bodies.
+pub fn leg_joint_torques(
+    mech: &Mechanics,
+    data: &mut Data,
+    leg: usize,
+    q: [f64; 3],
+    qd: [f64; 3],
+    qdd: [f64; 3],
+    foot_force: Vector3<f64>,
+) -> [f64; 3] {
+    assert!(leg < LEG_COUNT, "leg {leg} of a hexapod");
+    let (mut x, mut xd, mut xdd) = ([0.0; DOF], [0.0; DOF], [0.0; DOF]);
+    for l in 0..LEG_COUNT {
+        for j in 0..3 {
+            x[joint_index(l, j)] = q[j];
+        }
+    }
+    for j in 0..3 {
+        xd[joint_index(leg, j)] = qd[j];
+        xdd[joint_index(leg, j)] = qdd[j];
+    }
+    relative_kinematics(&mech.model, data, &x, &xd);
+    data.clear_forces();
+    let foot = mech.legs[leg].links[3];
+    let p = data.point(foot, &mech.foot_local);
+    data.add_force(foot, &p, &foot_force);
+    let mut f = [0.0; DOF];
+    residual(&mech.model, data, &xdd, &mut f);
+    std::array::from_fn(|j| f[joint_index(leg, j)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::description::RobotDescription;
+    use crate::hexapod::MechanicsParameters;
+    use crate::mbs::STANDARD_GRAVITY;
+
+    fn amru5() -> (Mechanics, Data) {
+        let mech = Mechanics::new(&MechanicsParameters::from_description(
+            &RobotDescription::amru5(),
+        ))
+        .unwrap();
+        let data = Data::new(&mech.model);
+        (mech, data)
+    }
+
+    /// Virtual work: at rest, the gravity torque of q_v is the weight of the leg's moving
+    /// parts times the vertical speed of their centres of mass per unit q'_v, which a finite
+    /// difference of the potential energy gives independently of the residual.
+    #[test]
+    fn gravity_torque_is_the_gradient_of_the_potential_energy() {
+        let (mech, mut data) = amru5();
+        let q = [0.1, 0.055, 0.03];
+        let tau = leg_joint_torques(&mech, &mut data, 2, q, [0.0; 3], [0.0; 3], Vector3::zeros());
+        let potential = |q: [f64; 3], data: &mut Data| {
+            let mut x = [0.0; DOF];
+            for l in 0..LEG_COUNT {
+                for j in 0..3 {
+                    x[joint_index(l, j)] = q[j];
+                }
+            }
+            relative_kinematics(&mech.model, data, &x, &[0.0; DOF]);
+            let leg = &mech.legs[2];
+            leg.links
+                .iter()
+                .chain(leg.rotors.iter())
+                .chain(std::iter::once(&leg.chassis))
+                .map(|&b| mech.model.bodies[b.0].mass * STANDARD_GRAVITY * data.position(b).z)
+                .sum::<f64>()
+        };
+        for j in 0..3 {
+            let h = 1e-6;
+            let (mut qp, mut qm) = (q, q);
+            qp[j] += h;
+            qm[j] -= h;
+            let dv = (potential(qp, &mut data) - potential(qm, &mut data)) / (2.0 * h);
+            assert!(
+                (tau[j] - dv).abs() <= 1e-6 * dv.abs().max(1.0),
+                "joint {j}: {} vs dV/dq {dv}",
+                tau[j]
+            );
+        }
+        // Section 5.2.1: no gravity torque on q_r of a level body.
+        assert!(tau[0].abs() < 1e-9);
+    }
+
+    /// A vertical force F on the foot needs the torques −(∂z_foot/∂q) F: about 6 F on q_v
+    /// (z_foot ≈ −6 q_v, Eq. B.2; the thesis' "pantograph amplification", Section 5.3).
+    #[test]
+    fn foot_force_is_balanced_through_the_pantograph() {
+        let (mech, mut data) = amru5();
+        let q = [0.0, 0.05, 0.03];
+        let free = leg_joint_torques(&mech, &mut data, 1, q, [0.0; 3], [0.0; 3], Vector3::zeros());
+        let loaded = leg_joint_torques(
+            &mech,
+            &mut data,
+            1,
+            q,
+            [0.0; 3],
+            [0.0; 3],
+            Vector3::new(0.0, 0.0, 98.1),
+        );
+        let ratio = (loaded[1] - free[1]) / 98.1;
+        assert!((ratio - 6.0).abs() < 0.1, "q_v amplification {ratio}");
+    }
+
+    /// Inertia: the torques are linear in q'' at rest, and the same for every leg.
+    #[test]
+    fn torques_are_linear_in_the_acceleration_and_alike_for_all_legs() {
+        let (mech, mut data) = amru5();
+        let q = [-0.2, 0.05, 0.02];
+        let g = leg_joint_torques(&mech, &mut data, 0, q, [0.0; 3], [0.0; 3], Vector3::zeros());
+        let a = leg_joint_torques(
+            &mech,
+            &mut data,
+            0,
+            q,
+            [0.0; 3],
+            [0.3, 0.01, 0.02],
+            Vector3::zeros(),
+        );
+        let b = leg_joint_torques(
+            &mech,
+            &mut data,
+            0,
+            q,
+            [0.0; 3],
+            [0.6, 0.02, 0.04],
+            Vector3::zeros(),
+        );
+        for j in 0..3 {
+            assert!(
+                ((b[j] - g[j]) - 2.0 * (a[j] - g[j])).abs() < 1e-9 * (b[j] - g[j]).abs().max(1e-9)
+            );
+            assert!((a[j] - g[j]).abs() > 0.0);
+        }
+        for leg in 1..LEG_COUNT {
+            let other = leg_joint_torques(
+                &mech,
+                &mut data,
+                leg,
+                q,
+                [0.0; 3],
+                [0.3, 0.01, 0.02],
+                Vector3::zeros(),
+            );
+            for j in 0..3 {
+                assert!((other[j] - a[j]).abs() < 1e-9 * a[j].abs().max(1.0));
+            }
+        }
+    }
+}

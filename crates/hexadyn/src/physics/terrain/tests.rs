@@ -1,0 +1,247 @@
+//! Terrain geometry against independent oracles: a brute-force closest point over all
+//! triangles, the analytic step and heightfield against their meshes, planes tiled by triangles
+//! against the analytic planes.
+
+use nalgebra::Vector3;
+use rand::Rng;
+
+use super::*;
+use crate::physics::GroundContact;
+use crate::test_util::rng;
+
+/// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection 5.1.5),
+/// and whether it is inside the face (not on an edge or a vertex).
+fn closest_on_triangle(p: Vector3<f64>, a: Vector3<f64>, b: Vector3<f64>, c: Vector3<f64>) -> (Vector3<f64>, bool) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, false);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, false);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (a + d1 / (d1 - d3) * ab, false);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, false);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (a + d2 / (d2 - d6) * ac, false);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b), false);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    (a + ab * (vb * denom) + ac * (vc * denom), true)
+}
+
+/// Brute force over all triangles of a ground that every vertical line crosses once (a height
+/// field, possibly with vertical faces): the closest point gives the distance, the side comes
+/// from the height of the surface above or below p on its vertical line.
+fn brute_force(t: &Triangles, p: Vector3<f64>, radius: f64) -> Proximity {
+    let v = |i: u32| Vector3::from(t.vertices[i as usize]);
+    let mut best = (f64::INFINITY, Vector3::zeros(), Vector3::zeros(), false);
+    let mut surface_z = f64::NEG_INFINITY;
+    for f in &t.faces {
+        let (a, b, c) = (v(f[0]), v(f[1]), v(f[2]));
+        let (s, on_face) = closest_on_triangle(p, a, b, c);
+        let n = (b - a).cross(&(c - a));
+        let d = (p - s).norm();
+        if d < best.0 {
+            best = (d, s, n.normalize(), on_face);
+        }
+        // Height of the triangle on p's vertical line (barycentric in the xy projection).
+        if n.z.abs() > 1e-12 {
+            let w = |q: Vector3<f64>, r: Vector3<f64>| (r.x - q.x) * (p.y - q.y) - (r.y - q.y) * (p.x - q.x);
+            let (wa, wb, wc) = (w(b, c), w(c, a), w(a, b));
+            if (wa >= 0.0 && wb >= 0.0 && wc >= 0.0) || (wa <= 0.0 && wb <= 0.0 && wc <= 0.0) {
+                surface_z = surface_z.max(a.z - (n.x * (p.x - a.x) + n.y * (p.y - a.y)) / n.z);
+            }
+        }
+    }
+    let (d, s, face_normal, on_face) = best;
+    let sign = if p.z < surface_z { -1.0 } else { 1.0 };
+    let normal = if on_face { face_normal * face_normal.dot(&(p - s)).signum() * sign } else { sign * (p - s) / d };
+    Proximity { penetration: radius - sign * d, normal }
+}
+
+fn random_heightfield(seed: u64, n: usize, spacing: f64) -> Heightfield {
+    let mut r = rng(seed);
+    let heights = (0..n).map(|_| (0..n).map(|_| r.random_range(-0.05..0.05)).collect()).collect();
+    Heightfield::new([0.0, 0.0], spacing, heights).unwrap()
+}
+
+/// Random points over the middle of a square [0, w]², within `band` of the surface height.
+fn random_query(r: &mut impl Rng, terrain: &dyn Terrain, w: f64, band: f64) -> Vector3<f64> {
+    let (x, y) = (r.random_range(0.1 * w..0.9 * w), r.random_range(0.1 * w..0.9 * w));
+    Vector3::new(x, y, terrain.height_normal(x, y).0 + r.random_range(-band..band))
+}
+
+#[test]
+fn mesh_proximity_matches_brute_force_on_ten_thousand_queries() {
+    // A random heightfield (1682 triangles) and a block with vertical faces.
+    let field = random_heightfield(31, 30, 0.1);
+    let block = generate::step_block(0.08);
+    let block_mesh = MeshTerrain::new(block.clone()).unwrap();
+    let field_triangles = field.triangles(Extent { centre: [0.0; 2], half_width: 0.0 });
+    let mut r = rng(32);
+    for k in 0..10_000 {
+        let radius = if k % 2 == 0 { 0.0 } else { 0.02 };
+        let (terrain, triangles, p): (&dyn Terrain, &Triangles, Vector3<f64>) = if k % 4 < 2 {
+            (&field, &field_triangles, random_query(&mut r, &field, 2.9, 0.08))
+        } else {
+            let p = Vector3::new(r.random_range(0.7..3.3), r.random_range(-0.4..0.2), r.random_range(-0.05..0.13));
+            (&block_mesh, &block, p)
+        };
+        let got = terrain.proximity(&p, radius);
+        let want = brute_force(triangles, p, radius);
+        assert!((got.penetration - want.penetration).abs() < 1e-9, "query {k} at {p:?}: δ = {} vs brute force {}", got.penetration, want.penetration);
+        assert!((got.normal - want.normal).norm() < 1e-9, "query {k} at {p:?}: n = {:?} vs brute force {:?}", got.normal, want.normal);
+    }
+}
+
+#[test]
+fn sliding_across_a_tiled_plane_feels_no_edge() {
+    // The plane z = 0.1 + 0.2 x - 0.1 y tiled by 2 x 22 x 22 = 968 triangles.
+    let slope = Slope { height: 0.1, slope_x: 0.2, slope_y: -0.1 };
+    let n = 23;
+    let heights = (0..n).map(|j| (0..n).map(|i| slope.height_normal(i as f64 * 0.05, j as f64 * 0.05).0).collect()).collect();
+    let tiled = Heightfield::new([0.0, 0.0], 0.05, heights).unwrap();
+    assert_eq!(tiled.triangles(Extent { centre: [0.0; 2], half_width: 0.0 }).faces.len(), 968);
+    for radius in [0.0, 0.02] {
+        let contact = GroundContact { foot_radius: radius, ..GroundContact::default() };
+        let (_, normal) = slope.height_normal(0.0, 0.0);
+        let depth = 1e-3;
+        // A straight slide over the plane at constant depth, crossing edges, diagonals and vertices.
+        let (start, end) = (Vector3::new(0.2, 0.13, 0.0), Vector3::new(0.93, 0.87, 0.0));
+        let v = Vector3::new(0.01, 0.003, 0.0);
+        let reference = contact.force(&(Vector3::new(0.5, 0.5, slope.height_normal(0.5, 0.5).0) - (depth - radius) * normal), &v, &slope);
+        for k in 0..=2000 {
+            let q = start + (end - start) * (k as f64 / 2000.0);
+            let p = Vector3::new(q.x, q.y, slope.height_normal(q.x, q.y).0) - (depth - radius) * normal;
+            let on_mesh = contact.force(&p, &v, &tiled);
+            let analytic = contact.force(&p, &v, &slope);
+            assert!((on_mesh.normal_force / reference.normal_force - 1.0).abs() < 1e-6, "r = {radius}, sample {k}: F_n = {} vs {}", on_mesh.normal_force, reference.normal_force);
+            assert!((on_mesh.force - analytic.force).norm() < 1e-6 * analytic.force.norm(), "r = {radius}, sample {k}: {:?} vs {:?}", on_mesh.force, analytic.force);
+        }
+    }
+}
+
+#[test]
+fn flat_ground_mesh_gives_the_flat_ground_force() {
+    let flat = FlatGround { height: 0.02 };
+    let mesh = MeshTerrain::new(flat.triangles(Extent { centre: [0.0, 0.0], half_width: 2.0 })).unwrap();
+    let contact = GroundContact::default();
+    let mut r = rng(33);
+    for _ in 0..1000 {
+        let p = Vector3::new(r.random_range(-1.5..1.5), r.random_range(-1.5..1.5), 0.02 - r.random_range(-1e-3..5e-3));
+        let v = Vector3::new(r.random_range(-0.01..0.01), r.random_range(-0.01..0.01), r.random_range(-0.01..0.01));
+        let (a, b) = (contact.force(&p, &v, &flat), contact.force(&p, &v, &mesh));
+        assert!((a.force - b.force).norm() <= 1e-9 * (1.0 + a.force.norm()), "{a:?} vs {b:?}");
+        assert!((a.penetration - b.penetration).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn analytic_step_matches_its_mesh() {
+    let mut r = rng(34);
+    for _ in 0..20 {
+        let step = Step { base: r.random_range(-0.1..0.1), rise: r.random_range(0.01..0.12), edge: r.random_range(-0.5..0.5), azimuth: r.random_range(-3.0..3.0) };
+        let mesh = MeshTerrain::new(step.triangles(Extent { centre: [0.1, -0.2], half_width: 2.0 })).unwrap();
+        for _ in 0..500 {
+            let u = Vector3::new(step.azimuth.cos(), step.azimuth.sin(), 0.0);
+            // Points near the edge, well inside the meshed square.
+            let p = u * (step.edge + r.random_range(-0.2..0.2)) + Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0) + Vector3::new(0.0, 0.0, step.base + r.random_range(-0.05..step.rise + 0.05));
+            let radius = r.random_range(0.0..0.03);
+            let (a, b) = (step.proximity(&p, radius), mesh.proximity(&p, radius));
+            assert!((a.penetration - b.penetration).abs() < 1e-9, "{step:?} at {p:?}: δ = {} vs mesh {}", a.penetration, b.penetration);
+            assert!((a.normal - b.normal).norm() < 1e-9, "{step:?} at {p:?}: n = {:?} vs mesh {:?}", a.normal, b.normal);
+            let (h, _) = step.height_normal(p.x, p.y);
+            assert!((h - mesh.height_normal(p.x, p.y).0).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn step_edge_treatment() {
+    let step = Step { base: 0.0, rise: 0.08, edge: 1.0, azimuth: 0.0 };
+    // Above the top corner: pushed away from the corner, continuously.
+    let p = step.proximity(&Vector3::new(0.99, 0.3, 0.09), 0.02);
+    let d: Vector3<f64> = Vector3::new(-0.01, 0.0, 0.01);
+    assert!((p.penetration - (0.02 - d.norm())).abs() < 1e-15);
+    assert!((p.normal - d.normalize()).norm() < 1e-15);
+    // A point foot sunk into the top face: up while nearer the top, sideways once nearer the face.
+    assert_eq!(step.proximity(&Vector3::new(1.01, 0.0, 0.075), 0.0).normal, Vector3::z());
+    assert_eq!(step.proximity(&Vector3::new(1.004, 0.0, 0.075), 0.0).normal, -Vector3::x());
+    // In front of the face, low side.
+    let p = step.proximity(&Vector3::new(0.97, 0.0, 0.04), 0.0);
+    assert!((p.penetration + 0.03).abs() < 1e-15 && p.normal == -Vector3::x());
+}
+
+#[test]
+fn heightfield_height_matches_its_mesh() {
+    let field = random_heightfield(35, 12, 0.25);
+    let mesh = MeshTerrain::new(field.triangles(Extent { centre: [0.0; 2], half_width: 0.0 })).unwrap();
+    let mut r = rng(36);
+    for _ in 0..5000 {
+        let (x, y) = (r.random_range(0.0..2.75), r.random_range(0.0..2.75));
+        let ((h, n), (hm, nm)) = (field.height_normal(x, y), mesh.height_normal(x, y));
+        assert!((h - hm).abs() < 1e-9, "({x}, {y}): {h} vs mesh {hm}");
+        assert!((n - nm).norm() < 1e-9, "({x}, {y}): {n:?} vs mesh {nm:?}");
+    }
+}
+
+#[test]
+fn mesh_faces_are_turned_up_and_bad_meshes_refused() {
+    // A face given clockwise from above is turned over.
+    let t = Triangles { vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], faces: vec![[0, 2, 1]] };
+    let mesh = MeshTerrain::new(t.clone()).unwrap();
+    assert!((mesh.proximity(&Vector3::new(0.2, 0.2, -0.01), 0.0).penetration - 0.01).abs() < 1e-15);
+    let mut bad = t.clone();
+    bad.vertices[1][2] = f64::NAN;
+    assert!(matches!(MeshTerrain::new(bad), Err(MeshError::NonFiniteVertex { index: 1, .. })));
+    let mut bad = t.clone();
+    bad.faces[0] = [0, 1, 3];
+    assert!(matches!(MeshTerrain::new(bad), Err(MeshError::IndexOutOfRange { face: 0, index: 3, .. })));
+    let mut bad = t.clone();
+    bad.vertices[2] = [2.0, 0.0, 0.0];
+    assert!(matches!(MeshTerrain::new(bad), Err(MeshError::Degenerate { face: 0, .. })));
+    assert_eq!(MeshTerrain::new(Triangles { vertices: t.vertices, faces: vec![] }).unwrap_err(), MeshError::Empty);
+}
+
+#[test]
+fn shipped_terrains_are_the_generated_ones() {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios/terrains");
+    for (name, triangles) in generate::shipped() {
+        let mut bytes = Vec::new();
+        ply::write(&triangles, generate::SHIPPED_FORMAT, &mut bytes).unwrap();
+        let path = folder.join(name);
+        let shipped = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e} (make terrains)", path.display()));
+        assert!(shipped == bytes, "{} differs from what make_terrains generates (make terrains)", path.display());
+        ply::parse_terrain(&shipped, name).unwrap();
+    }
+}
+
+#[test]
+fn shipped_terrains_have_the_geometry_of_section_7_7_5() {
+    let step = MeshTerrain::new(generate::step_block(0.08)).unwrap();
+    assert!((step.height_normal(2.0, -0.4).0 - 0.08).abs() < 1e-12);
+    assert!(step.height_normal(2.0, 0.3).0.abs() < 1e-12);
+    assert!(step.height_normal(0.5, -0.4).0.abs() < 1e-12);
+    let ramp = MeshTerrain::new(generate::ramp(20f64.to_radians())).unwrap();
+    let (_, n) = ramp.height_normal(1.0, 0.5);
+    assert!((n.z.acos().to_degrees() - 20.0).abs() < 1e-4);
+    let rough = generate::rough(0.015, 7);
+    let z: Vec<f64> = rough.vertices.iter().filter(|v| v[0].hypot(v[1]) > 1.2).map(|v| v[2]).collect();
+    let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64).sqrt();
+    assert!((rms - 0.015).abs() < 0.003, "RMS {rms}");
+    assert!(rough.vertices.iter().filter(|v| v[0].hypot(v[1]) < 0.6).all(|v| v[2] == 0.0));
+}

@@ -1,0 +1,101 @@
+"""What the identification hands to a simulation: the ``[model.joint_friction]`` fragment of a
+scenario file (docs/scenario-format.md) and the friction statistics of the Monte Carlo runs
+(Table 6.7, ``hexadyn montecarlo --friction-stats``).
+
+The fragment gives every leg the same friction, the mean over the legs and the campaigns of
+each identified parameter (as the Monte Carlo runs of Section 6.5 do). The Section 6.1 rule
+applies: a negative viscous slope is not physical and is written as 0 (the measured value in
+a comment). The breakaway torques of the vertical joints are written as comments: the scenario
+fragment has no stiction key (the robot description holds them, Table 5.4).
+
+The statistics follow the construction of Table 6.7 (``description/monte_carlo.rs``): per
+parameter, mu* is the mean of the leg means (each the mean over the campaigns, Eq. 5.8) and
+sigma* the (n - 1) standard deviation of the leg means (Eq. 5.9).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hexadyn.identify.identification import Identification
+from hexadyn.identify.logs import LEGS
+from hexadyn.identify.tables import mean_sigma
+
+__all__ = ["leg_means", "joint_friction_fragment", "friction_stats", "friction_stats_toml"]
+
+#: Fragment key -> (direction, attribute of the fit).
+STEADY_KEYS = {"tau_f_d_plus": (1, "tau_f_d"), "f_v_plus": (1, "f_v"), "tau_f_d_minus": (-1, "tau_f_d"), "f_v_minus": (-1, "f_v")}
+LOAD_KEYS = {"a_2_plus": (1, "a_2"), "a_1_plus": (1, "a_1"), "a_2_minus": (-1, "a_2"), "a_1_minus": (-1, "a_1")}
+
+
+def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
+    """Fragment key -> the mean over the campaigns of each leg that has it."""
+    out: dict[str, list[float]] = {}
+    for key, (direction, attr) in STEADY_KEYS.items():
+        values = [mean_sigma([getattr(f, attr).value for f in ident.unloaded(joint, leg, direction)])[0] for leg in LEGS]
+        out[key] = [v for v in values if not math.isnan(v)]
+    if joint == "q_h":
+        for key, (direction, attr) in LOAD_KEYS.items():
+            out[key] = [getattr(f, attr).value for f in ident.load_fits if f.direction == direction]
+    return {k: v for k, v in out.items() if v}
+
+
+def _physical(key: str, value: float) -> float:
+    """The Section 6.1 rule and the signs the scenario fields allow."""
+    if key.endswith("_plus"):
+        return max(value, 0.0)
+    return max(value, 0.0) if key.startswith("f_v") else min(value, 0.0)
+
+
+def joint_friction_fragment(ident: Identification) -> str:
+    """The ``[model.joint_friction.<joint>]`` tables of the identified joints (TOML text)."""
+    lines = [
+        "# Joint friction identified by `hexadyn identify` (thesis Sections 5.2-5.4): the mean over",
+        "# the legs and the campaigns, the same for every leg. Paste into a scenario file, or",
+        "# pass its keys as overrides (docs/identification.md).",
+    ]
+    for joint in ident.joints():
+        means = leg_means(ident, joint)
+        if not means and joint != "q_v":
+            continue
+        lines += ["", f"[model.joint_friction.{joint}]"]
+        for key, values in means.items():
+            value = float(np.mean(values))
+            kept = _physical(key, value)
+            note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g} (Section 6.1)"
+            lines.append(f"{key} = {kept:.9g}{note}")
+        if joint == "q_v":
+            for b_dir, sign in ((1, "plus"), (-1, "minus")):
+                for load in sorted({b.load_kg for b in ident.breakaways}):
+                    values = [b.tau_f_s for b in ident.breakaways if b.direction == b_dir and b.load_kg == load and not b.reason]
+                    if values:
+                        lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.q_v.stiction]): {np.mean(values):.6g} N")
+    return "\n".join(lines) + "\n"
+
+
+def friction_stats(ident: Identification) -> dict[str, dict[str, float]]:
+    """Scenario field -> {mu, sigma, legs} of every parameter identified on two legs or more."""
+    stats = {}
+    for joint in ident.joints():
+        for key, values in leg_means(ident, joint).items():
+            if len(values) < 2:
+                continue
+            mu, sigma = mean_sigma(values)
+            stats[f"model.joint_friction.{joint}.{key}"] = {"mu": mu, "sigma": sigma, "legs": len(values)}
+    return stats
+
+
+def friction_stats_toml(ident: Identification) -> str:
+    """:func:`friction_stats` as the file ``hexadyn montecarlo --friction-stats`` reads."""
+    lines = [
+        "# Friction statistics identified by `hexadyn identify` (Eq. 5.8-5.9, Table 6.7 layout):",
+        "# mu = mean of the leg means, sigma = (n - 1) standard deviation of the leg means.",
+        "# `hexadyn montecarlo SCENARIO --friction-stats THIS_FILE` draws from them.",
+        "",
+        "[friction_stats]",
+    ]
+    for field, s in friction_stats(ident).items():
+        lines.append(f'"{field}" = {{ mu = {s["mu"]:.9g}, sigma = {s["sigma"]:.9g}, legs = {s["legs"]} }}')
+    return "\n".join(lines) + "\n"

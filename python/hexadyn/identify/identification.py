@@ -1,0 +1,132 @@
+"""The identification of a set of logs: which experiment each joint of each log is, the fits of
+Sections 5.2-5.4, and their statistics over campaigns (Eq. 5.8-5.9).
+
+Every log is one measurement campaign of the joints it moved (the thesis repeated each campaign
+five times): a sawtooth log gives one dry/viscous fit per joint, direction and foot load; a
+voltage-ramp log one breakaway per joint. The tables give, per leg, the mean and the standard
+deviation of these over the campaigns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Iterable
+
+import numpy as np
+
+from hexadyn.identify.breakaway import Breakaway, BreakawayOptions, breakaway
+from hexadyn.identify.logs import JOINT_TYPES, LEGS, IdentifyError, Log
+from hexadyn.identify.sections import SectionOptions
+from hexadyn.identify.steady import DryViscousFit, LoadFit, SectionPoint, fit_dry_viscous, fit_load, section_points
+
+__all__ = ["Identification", "identify", "experiment_of", "SAWTOOTH", "BREAKAWAY"]
+
+SAWTOOTH = "sawtooth"
+BREAKAWAY = "breakaway"
+
+
+@dataclass
+class Identification:
+    """What the logs gave.
+
+    Attributes:
+        points: every constant-velocity section (Fig. 5.3-5.5).
+        fits: one dry/viscous line per (log, joint, leg, direction) and foot load.
+        breakaways: one tau_f,s per (log, leg, direction) of the vertical joints.
+        load_fits: Eq. 5.12 per (leg, direction) of the horizontal joints, with loaded logs.
+    """
+
+    points: list[SectionPoint] = field(default_factory=list)
+    fits: list[tuple[str, DryViscousFit]] = field(default_factory=list)
+    breakaways: list[Breakaway] = field(default_factory=list)
+    load_fits: list[LoadFit] = field(default_factory=list)
+
+    def unloaded(self, joint: str, leg: int, direction: int) -> list[DryViscousFit]:
+        """The fits of one joint and direction without foot load, one per campaign."""
+        return [f for _, f in self.fits if f.joint == joint and f.leg == leg and f.direction == direction and f.load_kg == 0.0]
+
+    def joints(self) -> list[str]:
+        return [j for j in JOINT_TYPES if any(f.joint == j for _, f in self.fits) or (j == "q_v" and self.breakaways)]
+
+
+def experiment_of(log: Log, joint: str, leg: int) -> str | None:
+    """``"sawtooth"``, ``"breakaway"`` or None (the joint was held or is not in the log).
+
+    A results folder says it through its scenario's motions (``sawtooth`` or
+    ``voltage_ramp``). In a CSV log, a joint with a voltage column whose position moves one
+    way only is a breakaway record, a joint that reverses at least twice a sawtooth.
+    """
+    if log.motions is not None:
+        kind = log.motions.get((joint, leg))
+        return {"sawtooth": SAWTOOTH, "voltage_ramp": BREAKAWAY}.get(kind or "")
+    if not log.has(joint, leg):
+        return None
+    q = log.position(joint, leg)
+    steps = np.sign(np.diff(q))
+    steps = steps[steps != 0]
+    reversals = int(np.count_nonzero(np.diff(steps) != 0)) if len(steps) else 0
+    if f"u_{joint}[{leg}]" in log.frame and np.ptp(q) > 0 and reversals < 2:
+        return BREAKAWAY
+    return SAWTOOTH if np.ptp(q) > 0 else None
+
+
+def identify(
+    logs: Iterable[Log],
+    joint: str | None = None,
+    sections: SectionOptions = SectionOptions(),
+    breakaway_options: BreakawayOptions = BreakawayOptions(),
+    seed: int = 0,
+    progress: Callable[[str], object] | None = None,
+) -> Identification:
+    """Identifies the friction of every joint the logs exercise (only `joint` if given).
+
+    Raises:
+        IdentifyError: a log lacks what its experiment needs (naming the file and the column,
+            section or joint), or nothing in the logs can be identified.
+    """
+    result = Identification()
+    for log in logs:
+        found = False
+        for j in JOINT_TYPES if joint is None else (joint,):
+            for leg in LEGS:
+                kind = experiment_of(log, j, leg)
+                if kind == SAWTOOTH:
+                    _sawtooth(result, log, j, leg, sections, seed)
+                elif kind == BREAKAWAY:
+                    result.breakaways.append(breakaway(log, leg, breakaway_options, j))
+                found = found or kind is not None
+        if not found:
+            which = "any joint" if joint is None else f"a {joint} joint"
+            raise IdentifyError(f"{log.source}: no sawtooth or voltage-ramp record of {which} with a position and a current column")
+        if progress:
+            progress(log.source)
+    result.load_fits = _load_fits(result, seed)
+    return result
+
+
+def _sawtooth(result: Identification, log: Log, joint: str, leg: int, options: SectionOptions, seed: int) -> None:
+    points = section_points(log, joint, leg, options)
+    result.points.extend(points)
+    for direction in (1, -1):
+        mine = [p for p in points if p.direction == direction]
+        if not mine:
+            raise IdentifyError(f"{log.source}: {joint}[{leg}]: no complete section in the {'plus' if direction > 0 else 'minus'} direction")
+        try:
+            result.fits.append((log.source, fit_dry_viscous(mine, seed)))
+        except ValueError as exc:
+            raise IdentifyError(str(exc)) from None
+
+
+def _load_fits(result: Identification, seed: int) -> list[LoadFit]:
+    fits = []
+    for leg in LEGS:
+        for direction in (1, -1):
+            loaded = [f for _, f in result.fits if f.joint == "q_h" and f.leg == leg and f.direction == direction and f.load_kg > 0]
+            if len({f.load_kg for f in loaded}) < 2:
+                continue
+            unloaded = result.unloaded("q_h", leg, direction)
+            if not unloaded:
+                raise IdentifyError(f"q_h[{leg}]: loaded logs ({sorted({f.load_kg for f in loaded})} kg) without an unloaded one: Eq. 5.12 needs a_0, the unloaded dry friction (add the unloaded campaign's log)")
+            a_0 = float(np.mean([f.tau_f_d.value for f in unloaded]))
+            fits.append(fit_load(a_0, loaded, seed))
+    return fits
