@@ -12,7 +12,7 @@ The numerics live in the Rust engine (``hexadyn._core``); this package is the us
     report.save(results, "results/stand")            # atomic; hexadyn.Results.load(folder)
 
 The modules build on each other in one direction, each importing only modules listed before
-it: ``vocabulary``, ``tomltext``, ``atomic`` (column names, TOML texts, atomic writes),
+it: ``vocabulary``, ``atomic``, ``health`` (column names, atomic writes, health checks of a run),
 ``results`` (the data), ``energy`` (the power analysis), ``plots`` (figures), ``report`` (the
 results folder), ``runner`` (:func:`simulate`), then ``compare``, ``montecarlo`` and ``cli``.
 """

@@ -2,9 +2,12 @@
 
 Both functions let a callback fill a temporary sibling of the target (same folder, hence same
 file system), sync it to disk and rename it to the target. A failure removes the temporary and
-leaves an existing target untouched. Used for results folders (:mod:`hexadyn.report`), the
-friction comparison (:mod:`hexadyn.compare`) and the Monte Carlo files
-(:mod:`hexadyn.montecarlo`).
+leaves an existing target untouched. The temporaries are named ``.NAME.PID.XXXXXXXX.partial``
+(``.old`` for a replaced folder on its way out), PID being the writing process: a process killed
+while writing (``kill -9``, a power cut) cannot remove its temporary, so every write first
+removes the temporaries in its folder whose process is gone (:func:`remove_stale`). Used for
+results folders (:mod:`hexadyn.report`), the friction comparison (:mod:`hexadyn.compare`) and
+the Monte Carlo files (:mod:`hexadyn.montecarlo`).
 """
 
 from __future__ import annotations
@@ -16,7 +19,10 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-__all__ = ["refuse_existing", "write_file", "write_folder"]
+__all__ = ["refuse_existing", "remove_stale", "write_file", "write_folder"]
+
+#: Suffixes of the temporaries of this module.
+_TEMPORARY_SUFFIXES = (".partial", ".old")
 
 
 def refuse_existing(target: str | os.PathLike, what: str) -> None:
@@ -28,7 +34,8 @@ def refuse_existing(target: str | os.PathLike, what: str) -> None:
 def write_file(path: Path, write: Callable[[Path], object]) -> None:
     """Writes a file atomically: ``write(tmp)`` fills a temporary file next to `path`, which is
     synced to disk and renamed to `path` (replacing an existing file)."""
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
+    remove_stale(path.parent)
+    fd, name = tempfile.mkstemp(prefix=_prefix(path), suffix=".partial", dir=path.parent)
     os.close(fd)
     tmp = Path(name)
     try:
@@ -48,16 +55,17 @@ def write_folder(target: Path, write: Callable[[Path], object]) -> None:
     `target` only once complete. On failure nothing is left: neither the temporary folder nor
     the parents this call created, and an existing `target` is untouched."""
     created = _make_parents(target.parent)
+    remove_stale(target.parent)
     tmp: Path | None = None
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=_prefix(target), suffix=".partial", dir=target.parent))
         os.chmod(tmp, 0o777 & ~_umask())
         write(tmp)
         for path in sorted(tmp.rglob("*")):
             if path.is_file():
                 _fsync(path)
         if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+            old = Path(tempfile.mkdtemp(prefix=_prefix(target), suffix=".old", dir=target.parent))
             os.rename(target, old / "previous")
             try:
                 os.rename(tmp, target)
@@ -78,6 +86,59 @@ def write_folder(target: Path, write: Callable[[Path], object]) -> None:
                 break
         raise
     _fsync_dir(target.parent)
+
+
+def remove_stale(folder: str | os.PathLike) -> list[Path]:
+    """Removes the temporaries (``.NAME.PID.XXXXXXXX.partial`` or ``.old``) in `folder` whose
+    writing process PID is no longer alive, and returns them. Those of live processes (another
+    run writing into the same folder) are left alone, as is anything not named so."""
+    removed = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    for path in entries:
+        pid = _owner(path.name)
+        if pid is None or _alive(pid):
+            continue
+        try:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+        except FileNotFoundError:  # removed meanwhile by another run
+            pass
+        removed.append(path)
+    return removed
+
+
+def _prefix(target: Path) -> str:
+    return f".{target.name}.{os.getpid()}."
+
+
+def _owner(name: str) -> int | None:
+    """The PID in the name of a temporary of this module, else None."""
+    suffix = next((s for s in _TEMPORARY_SUFFIXES if name.endswith(s)), None)
+    if not name.startswith(".") or suffix is None:
+        return None
+    parts = name[: -len(suffix)].rsplit(".", 2)
+    if len(parts) != 3 or not parts[0] or not parts[1].isdigit():
+        return None
+    return int(parts[1])
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's live process
+        return True
+    except OverflowError:
+        return False
+    return True
 
 
 def _make_parents(folder: Path) -> list[Path]:

@@ -7,6 +7,7 @@ Set ``HEXADYN_DEBUG=1`` to see the traceback of such an error.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import click
@@ -24,6 +25,10 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 # Exceptions that report bad input (a missing file, a wrong value in a scenario) rather than a
 # bug: they are shown as one clean line.
 USER_ERRORS: tuple[type[BaseException], ...] = (OSError, ValueError)
+#: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
+INTERRUPTED = 130
+#: Exit status of `simulate --strict` when a health check failed.
+UNHEALTHY = 3
 
 
 class HexadynGroup(click.Group):
@@ -36,6 +41,11 @@ class HexadynGroup(click.Group):
             if os.environ.get("HEXADYN_DEBUG"):
                 raise
             raise click.ClickException(_one_line(exc)) from exc
+        except KeyboardInterrupt:
+            if os.environ.get("HEXADYN_DEBUG"):
+                raise
+            click.echo("\nInterrupted: nothing was written.", err=True)
+            raise SystemExit(INTERRUPTED) from None
 
 
 @click.group(cls=HexadynGroup, context_settings={"help_option_names": ["-h", "--help"]})
@@ -101,13 +111,17 @@ def with_plot_options(f):
 @click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 @click.option("--no-plots", is_flag=True, help="Do not write the figures into <out>/plots/.")
+@click.option("--strict", is_flag=True, help=f"Exit with status {UNHEALTHY} if a health check of the run fails (see `warnings` in summary.json).")
 @with_plot_options
-def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
+def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
 
     Without SCENARIO the default scenario is run (see `hexadyn scenarios`). The results folder
-    gets the time series, the summary, the power and energy tables (power.csv, energy.csv) and,
-    unless --no-plots, the figures in plots/ (see `hexadyn plot`).
+    gets the time series (streamed to disk as the run goes), the summary, the power and energy
+    tables (power.csv, energy.csv) and, unless --no-plots, the figures in plots/ (see `hexadyn
+    plot`). Every run checks its own health (energy balance, penetration, body fall, tracking);
+    failed checks are printed and listed under `warnings` in summary.json. Ctrl-C stops the run
+    and writes nothing (exit status 130).
     """
     from hexadyn import _core, report
 
@@ -118,13 +132,12 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
         out = free_results_folder(info["name"])
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
-    results = hexadyn.simulate(path, progress=not no_progress)
-    report.save(results, out, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
+    results = hexadyn.simulate(path, out, progress=not no_progress, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
     s = results.summary
     click.echo(f"Results: {out}")
     click.echo(f"  scenario    {info['name']} ({path})")
     click.echo(f"  simulated   {s['duration_s']:.3f} s in {s['wall_time_s']:.2f} s wall time, {s['integration_steps']} steps ({s['rejected_steps']} rejected)")
-    click.echo(f"  series      {results.timeseries.shape[0]} instants x {results.timeseries.shape[1]} columns")
+    click.echo(f"  series      {results.shape[0]} instants x {results.shape[1]} columns")
     click.echo(f"  body height {s['body_height_change_m'] * 1e3:+.4f} mm over the run")
     click.echo(
         f"  energy      electrical {s['energy_electrical_j']:.4g} J, Joule {s['energy_joule_j']:.4g} J, "
@@ -140,10 +153,17 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
             f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
-    _echo_power(results)
-    _echo_ground_detection(results)
-    if not no_plots:
+    if report.in_memory(results):
+        _echo_power(results)
+        _echo_ground_detection(results)
+    else:
+        click.echo(f"  analysis    skipped {s['analysis_skipped']}")
+    if (out / "plots").is_dir():
         click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
+    for warning in s["warnings"]:
+        click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
+    if s["warnings"] and strict:
+        raise SystemExit(UNHEALTHY)
 
 
 def _echo_power(results: hexadyn.Results) -> None:
@@ -205,6 +225,8 @@ def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
     from hexadyn import report
 
     results = hexadyn.Results.load(folder)
+    if not report.in_memory(results):
+        raise ValueError(f"{folder}: the time series ({results.shape[0]} instants) is too long to plot in memory; plot a part of it from Python (Results.read_columns)")
     figures = report.plot(results, folder / "plots", legs=legs, formats=formats)
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
 
@@ -261,6 +283,9 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
     click.echo("  robot power and specific resistance (Fig. 6.19); friction_share = friction work / electrical energy, friction_power_share = 1 - P(no friction) / P:")
     for line in robot[columns].to_string(index=False, float_format=fmt).splitlines():
         click.echo(f"    {line}")
+    if result.fit.empty:
+        click.echo("  fit P = alpha + beta V_x (Eq. 6.8) skipped: it needs at least two velocities")
+        return
     click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
     for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
         click.echo(f"    {line}")
@@ -337,8 +362,17 @@ cli.add_command(view)
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the ``hexadyn`` console script."""
-    cli.main(args=argv, prog_name="hexadyn")
+    """Entry point of the ``hexadyn`` console script. After Ctrl-C (everything already cleaned
+    up and reported) the process ends at once, without the interpreter's teardown of pandas,
+    pyarrow and matplotlib, which takes seconds on a loaded machine."""
+    try:
+        cli.main(args=argv, prog_name="hexadyn")
+    except SystemExit as exc:
+        if exc.code != INTERRUPTED:
+            raise
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
 
 
 def _one_line(exc: BaseException) -> str:

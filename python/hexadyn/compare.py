@@ -24,6 +24,7 @@ Outputs (:func:`compare_friction`, written atomically by :func:`save`):
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -37,7 +38,6 @@ from matplotlib.figure import Figure
 from hexadyn import atomic, energy, plots
 from hexadyn.report import write_csv
 from hexadyn.runner import resolve_scenario, simulate
-from hexadyn.tomltext import parse_toml
 from hexadyn.vocabulary import JOINT_TYPES, LEGS
 
 #: Friction models of the comparison: name -> scenario overrides (Section 6.1 and 6.4.4).
@@ -61,6 +61,8 @@ MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_loa
 DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
 #: Scenario field of the forward velocity.
 VELOCITY_FIELD = "gait.heading.vx_m_s"
+#: Columns of the fit table (no rows with a single velocity: the fit needs two).
+FIT_COLUMNS = ("alpha_w", "beta_n", "xi_asymptote", "mass_kg")
 POWER_FILE = "power_by_model.csv"
 ROBOT_FILE = "robot_power.csv"
 FIT_FILE = "fit.csv"
@@ -145,7 +147,8 @@ def compare_friction(
 
     Args:
         scenario: a walking scenario file or shipped scenario name (constant heading).
-        velocities: forward velocities V_x (m/s), at least two distinct ones for the fit.
+        velocities: forward velocities V_x (m/s); the fit (``fit``) needs two distinct ones and is
+            empty with a single velocity.
         models: names among :data:`MODELS`.
         jobs: worker processes (default: the number of CPUs, at most the number of runs).
         progress: a tqdm bar over the runs (True), none (False), or ``progress(done, total)``.
@@ -180,15 +183,17 @@ def compare_friction(
 
 def _check_velocities(velocities: Sequence[float]) -> list[float]:
     v = [float(x) for x in velocities]
-    if len(set(v)) < 2 or any(not x > 0 for x in v):
-        raise ValueError(f"velocities {v}; allowed: at least two distinct positive velocities (m/s) for the fit of Eq. 6.8")
+    if not v or any(not (x > 0 and math.isfinite(x)) for x in v):
+        raise ValueError(f"velocities {v}; allowed: positive velocities (m/s), at least two distinct ones for the fit of Eq. 6.8")
     return sorted(set(v))
 
 
 def _scenario_velocity(path: Path) -> float | None:
-    heading = parse_toml(path.read_text(encoding="utf-8"), str(path)).get("gait", {}).get("heading", {})
-    value = heading.get("vx_m_s")
-    return float(value) if isinstance(value, (int, float)) else None
+    """The scenario's own V_x, as the engine read it (None without a constant heading)."""
+    from hexadyn import _core
+
+    gait = _core.load_scenario(os.fspath(path))["gait"]
+    return None if gait is None else gait["vx_m_s"]
 
 
 def _progress_bar(progress: bool | Callable[[int, int], object], total: int) -> Callable[[int | None], None]:
@@ -219,12 +224,12 @@ def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: l
         p_none = robot.xs("none", level="model")["average_power_w"]
         robot["friction_power_share"] = 1 - robot.index.get_level_values("velocity_m_s").map(p_none).to_numpy() / robot["average_power_w"].to_numpy()
     fit_rows = {}
-    for m in models:
+    for m in models if len(velocities) >= 2 else ():  # the fit of Eq. 6.8 needs two velocities
         r = robot.xs(m, level="model")
         alpha, beta = energy.fit_power_velocity(r.index.to_numpy(), r["average_power_w"].to_numpy())
         mass = float(r["mass_kg"].iloc[0])
         fit_rows[m] = {"alpha_w": alpha, "beta_n": beta, "xi_asymptote": energy.specific_resistance_asymptote(beta, mass), "mass_kg": mass}
-    fit = pd.DataFrame.from_dict(fit_rows, orient="index").rename_axis("model")
+    fit = pd.DataFrame.from_dict(fit_rows, orient="index", columns=list(FIT_COLUMNS)).rename_axis("model")
     table_velocity = own_velocity if own_velocity in velocities else velocities[0]
     return Comparison(name, power, robot, fit, table_velocity)
 
@@ -241,7 +246,7 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
     """Fig. 6.19 (a) ``power_velocity`` and (b) ``specific_resistance`` with the α/β fits, and
     ``power_by_model``: the averaged power per actuator and model at the table velocity."""
     robot, fit = comparison.robot, comparison.fit
-    models = list(fit.index)
+    models = list(robot.index.unique("model"))
     v_all = np.array(sorted(robot.index.unique("velocity_m_s")))
     v_line = np.linspace(v_all.min() * 0.9, v_all.max() * 1.05, 100)
     out = {}
@@ -255,7 +260,8 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
             for m in models:
                 r = robot.xs(m, level="model")
                 ax.plot(r.index.to_numpy() * 100, r[value], linestyle="none", marker=MODEL_MARKERS[m], color=MODEL_COLOURS[m], label=MODEL_LABELS[m])
-                ax.plot(v_line * 100, curve(fit.loc[m], v_line), color=MODEL_COLOURS[m], linewidth=0.8)
+                if m in fit.index:
+                    ax.plot(v_line * 100, curve(fit.loc[m], v_line), color=MODEL_COLOURS[m], linewidth=0.8)
             ax.set_xlabel("velocity $V_x$ [cm/s]")
             ax.set_ylabel(ylabel)
             ax.legend(frameon=False)

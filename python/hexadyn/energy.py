@@ -36,7 +36,6 @@ import numpy as np
 import pandas as pd
 
 from hexadyn import _core
-from hexadyn.tomltext import parse_toml
 from hexadyn.vocabulary import ACTUATORS, JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
@@ -173,12 +172,20 @@ def _robot_properties(results: Results) -> dict[str, float]:
 def _magnetic_energy_change(results: Results) -> np.ndarray:
     """Δ(½ L i²) per actuator (J), non-zero only if the scenario models the inductance
     (``[model] inductance = true``, Eq. 3.91)."""
-    scenario = parse_toml(results.metadata.get("scenario", ""), "the scenario stored with these results")
-    if not scenario.get("model", {}).get("inductance", False):
+    if not _models_inductance(results):
         return np.zeros(len(ACTUATORS))
     inductance = _robot_properties(results)["inductance_h"]
-    i = results.timeseries[_columns("i")].to_numpy()
+    i = results.endpoints()[_columns("i")].to_numpy()
     return 0.5 * inductance * (i[-1] ** 2 - i[0] ** 2)
+
+
+def _models_inductance(results: Results) -> bool:
+    """``[model] inductance`` as the engine read it (``metadata["model"]``); results saved
+    before the engine reported it are read by the engine from their stored scenario text."""
+    model = results.metadata.get("model")
+    if isinstance(model, dict) and "inductance" in model:
+        return bool(model["inductance"])
+    return bool(_core.scenario_model(results.metadata.get("scenario", ""), "the scenario stored with these results")["inductance"])
 
 
 def energy_breakdown(results: Results) -> pd.DataFrame:
@@ -190,10 +197,10 @@ def energy_breakdown(results: Results) -> pd.DataFrame:
     work done on the mechanism (see the module doc). Mechanical work may be negative: the
     mechanism then drives the motor (e.g. a vertical joint lowering the body).
     """
-    ts = results.timeseries
+    ends = results.endpoints()
     kinds = {"electrical_j": "E_el", "joule_j": "E_joule", "friction_j": "E_fric"}
-    _require(ts, [c for quantity in kinds.values() for c in _columns(quantity)], "the energy breakdown")
-    first, last = ts.iloc[0], ts.iloc[-1]
+    _require(ends, [c for quantity in kinds.values() for c in _columns(quantity)], "the energy breakdown")
+    first, last = ends.iloc[0], ends.iloc[-1]
     table = pd.DataFrame(index=pd.Index(ACTUATORS, name="actuator"))
     table["leg"] = [leg for leg in LEGS for _ in JOINT_TYPES]
     table["joint"] = list(JOINT_TYPES) * len(LEGS)
@@ -286,7 +293,8 @@ def energy_figures(results: Results) -> dict[str, float]:
     """
     b = energy_breakdown(results)
     e_el = float(b["electrical_j"].sum())
-    duration = float(results.timeseries.index[-1] - results.timeseries.index[0])
+    t = results.endpoints().index
+    duration = float(t[-1] - t[0])
     mass = robot_mass(results)
     figures = {
         "average_power_w": e_el / duration,

@@ -22,14 +22,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import pandas as pd
 from matplotlib.figure import Figure
 
 from hexadyn import atomic, energy, ground_detection
 from hexadyn import plots as plotting
-from hexadyn.results import Results
+from hexadyn.results import IN_MEMORY_LIMIT_BYTES, Results
 
 POWER_FILE = "power.csv"
 ENERGY_FILE = "energy.csv"
@@ -56,26 +56,59 @@ def save(
     ``overwrite`` is true, in which case it is replaced only once the new folder is complete.
     ``legs`` and ``formats`` are those of :func:`plot`.
     """
+    if not overwrite:
+        atomic.refuse_existing(folder, "results folder")
+    figures = _figures(results, legs) if plots and in_memory(results) else None  # before anything is written
+    save_run(lambda tmp: results, folder, overwrite=overwrite, plots=plots, legs=legs, formats=formats, figures=figures)
+    return Path(folder)
+
+
+def save_run(
+    run: Callable[[Path], Results],
+    folder: str | os.PathLike,
+    *,
+    overwrite: bool = False,
+    plots: bool = False,
+    legs: Sequence[int] | None = None,
+    formats: Sequence[str] | None = None,
+    figures: Mapping[str, Figure] | None = None,
+) -> Results:
+    """:func:`save` of the results ``run(tmp)`` returns, called with the temporary folder so
+    that it may stream its time series there (:func:`hexadyn.simulate`). The power table and
+    the figures need the series in memory: they are left out, with a note in the summary
+    (``analysis_skipped``), for a series over :data:`hexadyn.results.IN_MEMORY_LIMIT_BYTES`."""
     target = Path(folder)
     if not overwrite:
         atomic.refuse_existing(target, "results folder")
-    figures = _figures(results, legs) if plots else None  # before anything is written
+    kept: list[Results] = []
 
     def write(tmp: Path) -> None:
+        results = run(tmp)
+        kept.append(results)
+        small = in_memory(results)
+        if not small:
+            results.summary["analysis_skipped"] = f"{POWER_FILE} and the figures: the time series ({results.shape[0]} instants) is too long to analyse in memory"
         results.write(tmp)
-        write_csv(tmp / POWER_FILE, energy.averaged_power(results))
+        if small:
+            write_csv(tmp / POWER_FILE, energy.averaged_power(results))
         write_csv(tmp / ENERGY_FILE, energy.energy_breakdown(results))
-        if ground_detection.has_experiment(results):
+        if small and ground_detection.has_experiment(results):
             stops = ground_detection.trials(results)
             write_csv(tmp / ground_detection.TRIALS_FILE, stops.set_index(["leg", "threshold_n", "trial"]))
             write_csv(tmp / ground_detection.TABLE_FILE, ground_detection.table(stops))
-        if figures is not None:
+        if plots and small:
             (tmp / PLOTS_DIR).mkdir()
-            _save_figures(figures, tmp / PLOTS_DIR, formats)
+            _save_figures(figures if figures is not None else _figures(results, legs), tmp / PLOTS_DIR, formats)
 
     atomic.write_folder(target, write)
+    results = kept[0]
     results.path = target
-    return target
+    return results
+
+
+def in_memory(results: Results) -> bool:
+    """Whether the time series is small enough for the analyses in memory."""
+    return results.series_bytes <= IN_MEMORY_LIMIT_BYTES
 
 
 def plot(

@@ -24,7 +24,7 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from hexadyn._core import __version__
 
@@ -34,11 +34,16 @@ if TYPE_CHECKING:  # pandas is imported when needed (keeps `import hexadyn` ligh
 TIMESERIES_FILE = "timeseries.parquet"
 METADATA_FILE = "metadata.json"
 SUMMARY_FILE = "summary.json"
+#: The largest time series kept in memory by :func:`hexadyn.simulate` without a results folder,
+#: and analysed in memory by :mod:`hexadyn.report` (the power table and the figures), in bytes
+#: of 8-byte floats. INTERPRETATION: a 1000 s walk (about 1e5 instants x 400 columns, 320 MB)
+#: still fits, with room for pandas' copies on a machine of a few GB.
+IN_MEMORY_LIMIT_BYTES = 400 * 2**20
 #: Identifies a hexadyn results folder in metadata.json.
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
 
-__all__ = ["Results", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE"]
+__all__ = ["Results", "SeriesWriter", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE"]
 
 
 class Results:
@@ -46,24 +51,29 @@ class Results:
 
     Attributes:
         timeseries: pandas DataFrame indexed by ``t`` (s), one column per recorded quantity
-            (``Z``, ``q_v[2]``, ``i_q_v[2]``, ``tau_f_q_v[2]``, ``Fz[2]``, ...).
+            (``Z``, ``q_v[2]``, ``i_q_v[2]``, ``tau_f_q_v[2]``, ``Fz[2]``, ...). Results saved to
+            or loaded from a folder read it from ``timeseries.parquet`` on first access; for
+            a long run that may not fit in memory, read a few columns with
+            :meth:`read_columns` or the file row group by row group with pyarrow.
         units: column name -> SI unit (``"t"`` included).
-        summary: totals and diagnostics (names carry their unit as a suffix).
-        metadata: ``scenario`` and ``robot`` (TOML texts), ``scenario_name``, ``scenario_path``,
-            ``robot_source``, ``hexadyn_version``, ``created``, ``units``, ``descriptions``.
+        summary: totals and diagnostics (names carry their unit as a suffix); ``warnings`` lists
+            the failed health checks of the run (:mod:`hexadyn.health`).
+        metadata: ``scenario`` and ``robot`` (TOML texts), ``model`` (the ``[model]`` flags
+            as the engine read them), ``scenario_name``, ``scenario_path``, ``robot_source``,
+            ``hexadyn_version``, ``created``, ``units``, ``descriptions``.
         path: the folder the results were saved to (:func:`hexadyn.report.save`) or loaded
             from, if any.
     """
 
     def __init__(
         self,
-        timeseries: pd.DataFrame,
+        timeseries: pd.DataFrame | None,
         units: Mapping[str, str],
         summary: Mapping[str, Any],
         metadata: Mapping[str, Any],
         path: Path | None = None,
     ) -> None:
-        self.timeseries = timeseries
+        self._timeseries = timeseries
         self.units = dict(units)
         self.summary = dict(summary)
         self.metadata = dict(metadata)
@@ -74,15 +84,15 @@ class Results:
     # -----------------------------------------------------------------------------------------
 
     @classmethod
-    def from_engine(cls, raw: Mapping[str, Any], scenario_path: str | os.PathLike | None = None) -> "Results":
+    def from_engine(cls, raw: Mapping[str, Any], scenario_path: str | os.PathLike | None = None, timeseries: pd.DataFrame | None = None) -> "Results":
         """Builds the results from the dict returned by ``hexadyn._core.run_scenario``, with
         the engine's summary as it is (:func:`hexadyn.simulate` adds the key figures of the
-        power analysis, :func:`hexadyn.energy.add_energy_figures`)."""
+        power analysis, :func:`hexadyn.energy.add_energy_figures`). `timeseries` replaces the
+        ``columns`` of a run whose series was handed out in chunks (None: read from ``path``)."""
         import pandas as pd
 
-        columns = raw["columns"]
-        frame = pd.DataFrame({name: values for name, values in columns.items()})
-        frame = frame.set_index("t")
+        if timeseries is None and raw["columns"]:
+            timeseries = pd.DataFrame(dict(raw["columns"])).set_index("t")
         units = dict(raw["units"])
         descriptions = dict(raw.get("descriptions", {}))
         summary = dict(raw["summary"])
@@ -94,16 +104,68 @@ class Results:
             "scenario_name": summary.get("scenario"),
             "scenario_path": None if scenario_path is None else str(scenario_path),
             "scenario": raw["scenario"],
+            "model": dict(raw.get("model", {})),
             "robot_source": raw.get("robot_source"),
             "robot": raw["robot"],
             "units": units,
             "descriptions": descriptions,
         }
-        return cls(frame, units, summary, metadata)
+        return cls(timeseries, units, summary, metadata)
 
     # -----------------------------------------------------------------------------------------
     # Access
     # -----------------------------------------------------------------------------------------
+
+    @property
+    def timeseries(self) -> pd.DataFrame:
+        if self._timeseries is None:
+            self._timeseries = _read_parquet(self._series_file())
+        return self._timeseries
+
+    @timeseries.setter
+    def timeseries(self, frame: pd.DataFrame) -> None:
+        self._timeseries = frame
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """(instants, columns) of the time series, without reading it."""
+        if self._timeseries is not None:
+            return self._timeseries.shape
+        import pyarrow.parquet as pq
+
+        meta = pq.ParquetFile(self._series_file()).metadata
+        return meta.num_rows, meta.num_columns - 1  # t is the index
+
+    @property
+    def series_bytes(self) -> int:
+        """The size of the time series in memory (8-byte floats)."""
+        rows, columns = self.shape
+        return 8 * rows * (columns + 1)
+
+    def read_columns(self, columns: Sequence[str]) -> pd.DataFrame:
+        """Some columns of the time series (indexed by ``t``), read from the file if the series is
+        not in memory: the way into a series too long for memory."""
+        if self._timeseries is not None:
+            return self._timeseries[list(columns)]
+        return _read_parquet(self._series_file(), columns=list(columns))
+
+    def endpoints(self) -> pd.DataFrame:
+        """The first and the last instant of the time series (two rows), read from the file's
+        first and last row group if the series is not in memory."""
+        if self._timeseries is not None:
+            return self._timeseries.iloc[[0, -1]]
+        import pandas as pd
+        import pyarrow.parquet as pq
+
+        file = pq.ParquetFile(self._series_file())
+        first = file.read_row_group(0).slice(0, 1).to_pandas()
+        last_group = file.read_row_group(file.num_row_groups - 1)
+        return pd.concat([first, last_group.slice(last_group.num_rows - 1, 1).to_pandas()])
+
+    def _series_file(self) -> Path:
+        if self.path is None:
+            raise ValueError("these results hold no time series (not in memory, no results folder)")
+        return self.path / TIMESERIES_FILE
 
     @property
     def descriptions(self) -> dict[str, str]:
@@ -115,7 +177,7 @@ class Results:
         return self.units[column]
 
     def __repr__(self) -> str:
-        rows, cols = self.timeseries.shape
+        rows, cols = self.shape
         name = self.metadata.get("scenario_name")
         where = f", path={str(self.path)!r}" if self.path else ""
         return f"<Results {name!r}: {rows} instants x {cols} columns{where}>"
@@ -127,39 +189,118 @@ class Results:
     def write(self, folder: Path) -> None:
         """Writes the files :meth:`load` reads (``timeseries.parquet``, ``metadata.json``,
         ``summary.json``) into the existing `folder`, as they are: not atomically, and
-        without the power tables and figures. :func:`hexadyn.report.save` writes a complete
-        results folder atomically."""
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        table = pa.Table.from_pandas(self.timeseries, preserve_index=True)
-        extra = json.dumps({"units": self.units, "hexadyn_version": self.metadata.get("hexadyn_version")})
-        table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"hexadyn": extra.encode()})
-        pq.write_table(table, folder / TIMESERIES_FILE)
+        without the power tables and figures (the time series is kept if it was streamed
+        there). :func:`hexadyn.report.save` writes a complete results folder atomically."""
+        target = folder / TIMESERIES_FILE
+        if self.path is None or self._series_file().resolve() != target.resolve():
+            frame = self.timeseries
+            with SeriesWriter(target, self.units) as writer:
+                writer.write_frame(frame)
         metadata = dict(self.metadata)
         metadata["units"] = self.units
-        metadata["columns"] = [self.timeseries.index.name, *map(str, self.timeseries.columns)]
+        metadata["columns"] = list(self.units)
         _write_json(folder / METADATA_FILE, metadata)
         _write_json(folder / SUMMARY_FILE, self.summary)
 
     @classmethod
     def load(cls, folder: str | os.PathLike) -> "Results":
-        """Reads a results folder (written by :func:`hexadyn.report.save`)."""
-        import pyarrow.parquet as pq
-
+        """Reads a results folder (written by :func:`hexadyn.report.save`); the time series is
+        read on first access. Raises ValueError naming the file for a broken folder."""
         folder = Path(folder)
         meta_path = folder / METADATA_FILE
         if not meta_path.is_file():
             if not folder.is_dir():
                 raise FileNotFoundError(errno.ENOENT, "no such results folder", str(folder))
             raise ValueError(f"{folder}: not a hexadyn results folder (no {METADATA_FILE})")
-        metadata = json.loads(meta_path.read_text(encoding="utf-8"))
+        metadata = _read_json_object(meta_path, "hexadyn results metadata")
         if metadata.get("format") != FORMAT:
             raise ValueError(f"{meta_path}: not hexadyn results metadata (format {metadata.get('format')!r}, expected {FORMAT!r})")
-        summary = json.loads((folder / SUMMARY_FILE).read_text(encoding="utf-8"))
-        frame = pq.read_table(folder / TIMESERIES_FILE).to_pandas()
+        for key, kind in (("units", dict), ("descriptions", dict), ("scenario", str), ("robot", str)):
+            if key in metadata and not isinstance(metadata[key], kind):
+                raise ValueError(f"{meta_path}: {key} is a {type(metadata[key]).__name__}; expected a JSON {'object' if kind is dict else 'string'}")
+        summary = _read_json_object(folder / SUMMARY_FILE, "the run's summary")
+        series = folder / TIMESERIES_FILE
+        if not series.is_file():
+            raise ValueError(f"{series}: {'a directory' if series.is_dir() else 'missing'}; expected the Parquet file of the time series")
         metadata.pop("columns", None)
-        return cls(frame, metadata.get("units", {}), summary, metadata, path=folder)
+        return cls(None, metadata.get("units", {}), summary, metadata, path=folder)
+
+
+class SeriesWriter:
+    """Writes a time series to ``timeseries.parquet`` chunk by chunk, one row group per chunk
+    (pyarrow's ParquetWriter): a long run is streamed to disk as it goes. The file is read
+    back by :meth:`Results.load` as a DataFrame indexed by ``t``; the units are in the schema
+    metadata (key ``hexadyn``)."""
+
+    def __init__(self, path: Path, units: Mapping[str, str] | None = None) -> None:
+        self.path = path
+        self.units = dict(units or {})
+        self.rows = 0
+        self._writer = None
+        self._schema = None
+
+    def write_columns(self, columns: Mapping[str, Any]) -> None:
+        """Appends a chunk: column name -> array, ``t`` among them (after the first chunk, the
+        arrays go to Parquet without a copy through pandas)."""
+        import pyarrow as pa
+
+        if self._writer is None:
+            import pandas as pd
+
+            self.write_frame(pd.DataFrame(dict(columns)).set_index("t"))
+            return
+        self._writer.write_table(pa.Table.from_arrays([pa.array(columns[name]) for name in self._schema.names], schema=self._schema))
+        self.rows += len(columns["t"])
+
+    def write_frame(self, frame: pd.DataFrame) -> None:
+        """Appends a chunk indexed by ``t``."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        if self._writer is None:
+            table = pa.Table.from_pandas(frame, preserve_index=True)
+            extra = json.dumps({"units": self.units, "hexadyn_version": __version__})
+            self._schema = table.schema.with_metadata({**(table.schema.metadata or {}), b"hexadyn": extra.encode()})
+            self._writer = pq.ParquetWriter(self.path, self._schema)
+        table = pa.Table.from_pandas(frame, schema=self._schema, preserve_index=True)
+        self._writer.write_table(table)
+        self.rows += len(frame)
+
+    def close(self) -> None:
+        if self._writer is not None:
+            self._writer.close()
+            self._writer = None
+
+    def __enter__(self) -> "SeriesWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _read_parquet(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    if not path.is_file():
+        raise ValueError(f"{path}: {'a directory' if path.is_dir() else 'missing'}; expected the Parquet file of the time series")
+    try:
+        return pq.read_table(path, columns=columns).to_pandas()
+    except (pa.ArrowException, OSError) as exc:
+        raise ValueError(f"{path}: not a readable time series: {exc}") from None
+
+
+def _read_json_object(path: Path, what: str) -> dict[str, Any]:
+    """A JSON file holding an object; ValueError naming the file otherwise."""
+    try:
+        value = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(f"{path}: missing ({what})") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: not valid JSON ({what}): {exc}") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"{path}: a JSON {type(value).__name__}; expected an object ({what})")
+    return value
 
 
 def _json_safe(value: Any) -> Any:

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import errno
 import os
+import shutil
 from pathlib import Path
-from typing import Any, Callable, Mapping, Union
+from typing import Any, Callable, Mapping, Sequence, Union
 
 from hexadyn import atomic
-from hexadyn.results import Results
+from hexadyn.results import IN_MEMORY_LIMIT_BYTES, TIMESERIES_FILE, Results, SeriesWriter
 
 #: Folder of the scenario files shipped with the package.
 SCENARIOS_DIR = Path(__file__).resolve().parent / "scenarios"
@@ -23,7 +24,7 @@ SCENARIOS_DIR = Path(__file__).resolve().parent / "scenarios"
 #: ``progress(t_s, duration_s)``.
 Progress = Union[bool, Callable[[float, float], object]]
 
-__all__ = ["SCENARIOS_DIR", "list_scenarios", "resolve_scenario", "simulate"]
+__all__ = ["SCENARIOS_DIR", "list_scenarios", "resolve_scenario", "safe_folder_name", "simulate"]
 
 
 def list_scenarios() -> list[Path]:
@@ -57,15 +58,25 @@ def simulate(
     *,
     overwrite: bool = False,
     overrides: Mapping[str, Any] | None = None,
+    plots: bool = False,
+    legs: Sequence[int] | None = None,
+    formats: Sequence[str] | None = None,
 ) -> Results:
     """Runs a scenario and returns its :class:`~hexadyn.results.Results`, whose summary also
-    holds the key figures of the power analysis (:func:`hexadyn.energy.add_energy_figures`).
+    holds the key figures of the power analysis (:func:`hexadyn.energy.add_energy_figures`) and
+    the failed health checks of the run (``warnings``, :func:`hexadyn.health.check`).
+
+    Without `out` the time series is kept in memory; a run whose series would exceed
+    :data:`IN_MEMORY_LIMIT_BYTES` is refused before it starts (give `out`). With `out` the
+    series is streamed to ``timeseries.parquet`` in the results folder as the run goes (memory
+    bounded by a constant whatever the duration), the folder is written atomically
+    (:func:`hexadyn.report.save`) and ``results.timeseries`` is read from it on first access; a
+    run whose series would not fit on the disk is refused before it starts.
 
     Args:
         scenario: a scenario file, or the name of a shipped scenario (see :func:`list_scenarios`).
-        out: if given, the results are also saved to this folder (atomically, with the power
-            tables, see :func:`hexadyn.report.save`); it must not exist unless ``overwrite``
-            is true.
+        out: if given, the results are saved to this folder (atomically, with the power tables,
+            see :func:`hexadyn.report.save`); it must not exist unless ``overwrite`` is true.
         progress: True for a tqdm progress bar over the simulated time (on stderr), False for
             none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
         overwrite: replace an existing ``out`` folder.
@@ -73,41 +84,90 @@ def simulate(
             ``{"model.friction": "dry_viscous", "gait.heading.vx_m_s": 0.01}`` (values: bool,
             int, float, str, lists and dicts of those). The results' metadata then holds the
             effective scenario text.
+        plots, legs, formats: with `out`, the figures of :func:`hexadyn.report.plot` in
+            ``out/plots`` (skipped for a series too long for memory).
 
     Raises:
         FileNotFoundError: no such scenario.
         ValueError: the scenario is invalid (one line naming the file, the field, the value and
-            what is allowed), or the simulation failed.
+            what is allowed), the simulation failed, or the series would not fit.
         FileExistsError: ``out`` exists and ``overwrite`` is false (checked before running).
     """
-    from hexadyn import _core, energy, report  # pandas and matplotlib: not at `import hexadyn`
+    from hexadyn import _core, energy, health, report  # pandas and matplotlib: not at `import hexadyn`
 
     path = resolve_scenario(scenario)
     if out is not None and not overwrite:
         atomic.refuse_existing(out, "results folder")
     overrides = dict(overrides) if overrides else None
-    if progress is True:
-        raw = _run_with_bar(_core, path, overrides)
-    else:
-        raw = _core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides)
-    results = Results.from_engine(raw, scenario_path=path)
-    energy.add_energy_figures(results)
-    if out is not None:
-        report.save(results, out, overwrite=overwrite)
-    return results
+    info = _core.load_scenario(os.fspath(path), overrides)  # invalid: nothing is created
+    rows = round(info["duration_s"] / info["period_s"]) + 1
+
+    def finish(results: Results) -> Results:
+        energy.add_energy_figures(results)
+        results.summary["warnings"] = health.check(results.summary)
+        return results
+
+    if out is None:
+        chunks: list[Mapping[str, Any]] = []
+
+        def keep(columns: Mapping[str, Any], units: Mapping[str, str]) -> None:
+            if not chunks:
+                _refuse_beyond(rows, len(columns), IN_MEMORY_LIMIT_BYTES, "memory", "pass out= to stream the series to a results folder")
+            chunks.append(columns)
+
+        raw = _run(_core, path, info, overrides, progress, keep)
+        import numpy as np
+        import pandas as pd
+
+        frame = pd.DataFrame({name: np.concatenate([c[name] for c in chunks]) for name in chunks[0]}).set_index("t")
+        return finish(Results.from_engine(raw, scenario_path=path, timeseries=frame))
+
+    def record(tmp: Path) -> Results:
+        with SeriesWriter(tmp / TIMESERIES_FILE) as writer:
+
+            def write(columns: Mapping[str, Any], units: Mapping[str, str]) -> None:
+                if writer.rows == 0:
+                    free = shutil.disk_usage(tmp).free
+                    _refuse_beyond(rows, len(columns), free, f"the free space of the disk of {out}", "shorten scenario.duration_s or choose another --out")
+                    writer.units = dict(units)
+                writer.write_columns(columns)
+
+            raw = _run(_core, path, info, overrides, progress, write)
+        results = Results.from_engine(raw, scenario_path=path)
+        results.path = tmp
+        return finish(results)
+
+    return report.save_run(record, out, overwrite=overwrite, plots=plots, legs=legs, formats=formats)
 
 
-def _run_with_bar(core, path: Path, overrides: dict | None) -> dict:
+def _refuse_beyond(rows: int, columns: int, limit: float, where: str, advice: str) -> None:
+    """Refuses a series of `rows` x `columns` 8-byte values larger than `limit` bytes."""
+    estimate = 8 * rows * columns
+    if estimate > limit:
+        raise ValueError(f"the time series would take about {_size(estimate)} ({rows} instants x {columns} columns x 8 bytes), more than {where} ({_size(limit)}); {advice}")
+
+
+def _size(n: float) -> str:
+    for unit in ("bytes", "kB", "MB", "GB", "TB"):
+        if n < 1000 or unit == "TB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1000
+    raise AssertionError("unreachable")
+
+
+def _run(core, path: Path, info: Mapping[str, Any], overrides: dict | None, progress: Progress, chunk: Callable[[Mapping[str, Any], Mapping[str, str]], None]) -> dict:
+    """The engine's run, the series handed to `chunk` as it goes."""
+    if progress is not True:
+        return core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides, chunk=chunk)
     from tqdm.auto import tqdm
 
-    info = core.load_scenario(os.fspath(path), overrides)
     duration = float(info["duration_s"])
     with tqdm(total=duration, desc=info["name"], unit="s", unit_scale=False, bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]") as bar:
 
         def update(t: float, _duration: float) -> None:
             bar.update(min(t, duration) - bar.n)
 
-        raw = core.run_scenario(os.fspath(path), update, overrides)
+        raw = core.run_scenario(os.fspath(path), update, overrides, chunk=chunk)
         bar.update(duration - bar.n)  # the last instant is duration up to rounding
     return raw
 
@@ -116,9 +176,20 @@ def _run_with_bar(core, path: Path, overrides: dict | None) -> dict:
 RESULTS_ROOT = Path("results")
 
 
+def safe_folder_name(name: str) -> str:
+    """A name (a scenario's ``scenario.name``) as the name of one folder: letters, digits,
+    ``.``, ``_`` and ``-`` are kept, anything else (``/``, ``\\``, spaces, control characters)
+    becomes ``_``; leading dots are dropped (no hidden folder, no ``..``); at most 100
+    characters; ``scenario`` if nothing is left. Only ``--out`` chooses another place."""
+    kept = "".join(c if (c.isalnum() and c.isascii()) or c in "._-" else "_" for c in name)
+    kept = kept.lstrip(".")[:100]
+    return kept or "scenario"
+
+
 def free_results_folder(name: str) -> Path:
-    """``results/<name>``, or ``results/<name>-2``, ``-3``... whichever does not exist yet."""
-    base = RESULTS_ROOT / name
+    """``results/<name>``, or ``results/<name>-2``, ``-3``... whichever does not exist yet;
+    the name is made a safe folder name first (:func:`safe_folder_name`)."""
+    base = RESULTS_ROOT / safe_folder_name(name)
     if not base.exists():
         return base
     n = 2

@@ -244,6 +244,7 @@ def test_walking_scenario(tmp_path: Path):
         "duty_factor": 0.5,
         "cycle": "enhanced",
         "heading": "constant",
+        "vx_m_s": 0.015,
         "navigation": False,
         "clearance_m": 0.105,
         "body_height_m": pytest.approx(0.414, abs=1e-3),

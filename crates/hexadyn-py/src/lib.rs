@@ -17,6 +17,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mbs::PyMultibody>()?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(scenario::scenario_model, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::terrain_triangles, m)?)?;
     m.add_function(wrap_pyfunction!(monte_carlo::monte_carlo_distributions, m)?)?;
     schema::register(m)?;

@@ -85,10 +85,11 @@ class Run:
             raise ViewError(f"{self.folder}: not a hexadyn results folder (needs {METADATA_FILE} and {TIMESERIES_FILE})")
         try:
             self.metadata = json.loads(meta_path.read_text(encoding="utf-8"))
-        except json.JSONDecodeError as exc:
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise ViewError(f"{meta_path}: not JSON ({exc})") from exc
-        if self.metadata.get("format") != FORMAT:
-            raise ViewError(f"{meta_path}: not hexadyn results metadata (format {self.metadata.get('format')!r}, expected {FORMAT!r})")
+        if not isinstance(self.metadata, dict) or self.metadata.get("format") != FORMAT:
+            found = self.metadata.get("format") if isinstance(self.metadata, dict) else f"a JSON {type(self.metadata).__name__}"
+            raise ViewError(f"{meta_path}: not hexadyn results metadata (format {found!r}, expected {FORMAT!r})")
         if not self.metadata.get("robot"):
             raise ViewError(f"{meta_path}: no robot description (key 'robot')")
         self._parquet = pq.ParquetFile(table_path)

@@ -55,15 +55,17 @@ impl RobotDescription {
     ///
     /// # Panics
     /// Never in a tested build: the embedded file is validated by the unit tests.
+    /// Parsed once per process (every scenario naming `"amru5"` starts from it).
     pub fn amru5() -> RobotDescription {
-        Self::from_str(AMRU5_TOML, AMRU5_ORIGIN).unwrap_or_else(|e| panic!("the embedded AMRU5 description is invalid: {e}"))
+        static PARSED: std::sync::OnceLock<RobotDescription> = std::sync::OnceLock::new();
+        PARSED.get_or_init(|| Self::from_str(AMRU5_TOML, AMRU5_ORIGIN).unwrap_or_else(|e| panic!("the embedded AMRU5 description is invalid: {e}"))).clone()
     }
 
     /// Reads and validates a description file; errors name `path`.
     pub fn from_file(path: impl AsRef<Path>) -> Result<RobotDescription> {
         let path = path.as_ref();
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| DescriptionError::Io { file: file.clone(), reason: e.to_string() })?;
+        let text = crate::fields::read_input(path).map_err(|reason| DescriptionError::Io { file: file.clone(), reason })?;
         Self::from_str(&text, &file)
     }
 
@@ -71,6 +73,7 @@ impl RobotDescription {
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, origin_name: &str) -> Result<RobotDescription> {
         let index = SpanIndex::build_for(text, origin_name, AMRU5_ORIGIN)?;
+        index.check_top_level(crate::fields::struct_fields::<RobotDescription>())?;
         let mut robot: RobotDescription = toml::from_str(text).map_err(|e| index.serde_error(&e))?;
         robot.origin = origin_name.to_string();
         robot.validate(&Ctx { file: origin_name, index: Some(&index) })?;

@@ -23,6 +23,56 @@ mod span_index;
 pub(crate) use bounded::{bounds, seq, Bound, Finite, NonNegative, Positive, Value, Violation};
 pub(crate) use span_index::SpanIndex;
 
+/// The largest input file read (scenario, robot description, heading CSV, link configuration):
+/// 64 MB, far above any real one (kilobytes; a 1000 s heading series at 100 Hz is 4 MB), so
+/// that naming a device (`/dev/zero`) or a huge file fails at once instead of filling memory.
+pub const MAX_INPUT_BYTES: u64 = 64 << 20;
+
+/// Reads an input file as text: a regular file of at most [`MAX_INPUT_BYTES`], in UTF-8. The
+/// error is a one-line reason.
+pub fn read_input(path: impl AsRef<std::path::Path>) -> std::result::Result<String, String> {
+    use std::io::Read;
+    let path = path.as_ref();
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let meta = file.metadata().map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(if meta.is_dir() { "a directory, not a file".into() } else { "not a regular file".into() });
+    }
+    if meta.len() > MAX_INPUT_BYTES {
+        return Err(format!("{} bytes, more than the {MAX_INPUT_BYTES} allowed for an input file", meta.len()));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_INPUT_BYTES + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(format!("more than the {MAX_INPUT_BYTES} bytes allowed for an input file"));
+    }
+    String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()))
+}
+
+/// The field names a serde-derived struct accepts (those its `Deserialize` passes to
+/// `deserialize_struct`), so that keys can be checked before values ([`SpanIndex::check_top_level`]).
+pub(crate) fn struct_fields<'de, T: serde::Deserialize<'de>>() -> &'static [&'static str] {
+    use serde::de::{self, Visitor};
+    struct Probe<'a>(&'a mut &'static [&'static str]);
+    impl<'de> serde::Deserializer<'de> for Probe<'_> {
+        type Error = de::value::Error;
+        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> std::result::Result<V::Value, Self::Error> {
+            Err(de::Error::custom("not a struct"))
+        }
+        fn deserialize_struct<V: Visitor<'de>>(self, _: &'static str, fields: &'static [&'static str], _: V) -> std::result::Result<V::Value, Self::Error> {
+            *self.0 = fields;
+            Err(de::Error::custom("probed"))
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf option unit unit_struct
+            newtype_struct seq tuple tuple_struct map enum identifier ignored_any
+        }
+    }
+    let mut fields: &'static [&'static str] = &[];
+    let _ = T::deserialize(Probe(&mut fields));
+    fields
+}
+
 /// An input file (robot description or scenario) that could not be read, parsed or validated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum DescriptionError {

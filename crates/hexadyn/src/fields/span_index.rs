@@ -43,7 +43,12 @@ impl<'t> SpanIndex<'t> {
     pub(crate) fn build_for(text: &'t str, file: &str, reference: &str) -> Result<Self> {
         let doc = toml::de::DeTable::parse(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((1, 1));
-            DescriptionError::Syntax { file: file.to_string(), line, column, message: e.message().trim().to_string() }
+            let mut message = e.message().trim().to_string();
+            // The parser does not say which key: the span does.
+            if let Some(key) = e.span().and_then(|s| text.get(s)).filter(|k| message == "duplicate key" && !k.trim().is_empty()) {
+                message = format!("duplicate key `{}`", shorten(key));
+            }
+            DescriptionError::Syntax { file: file.to_string(), line, column, message }
         })?;
         let mut index = SpanIndex { file: file.to_string(), text, reference: reference.to_string(), nodes: Vec::new() };
         index.walk_table(doc.get_ref(), "");
@@ -104,6 +109,23 @@ impl<'t> SpanIndex<'t> {
             let cut = path.rfind(['.', '['])?;
             path = &path[..cut];
         }
+    }
+
+    /// An error for the first top-level key that is not among `known` (a struct's fields,
+    /// [`super::struct_fields`]): checked before deserializing, so that a misspelt table
+    /// (`[giat]`) is reported as unknown rather than as the fields missing from the table it
+    /// was meant to be (serde visits the keys in sorted order: `gait` before `giat`).
+    pub(crate) fn check_top_level(&self, known: &[&str]) -> Result<()> {
+        if known.is_empty() {
+            return Ok(()); // not a plain struct (flattened): serde checks the keys itself
+        }
+        let Some((path, key, value)) = self.nodes.iter().find(|(path, _, _)| !path.contains(['.', '[']) && !known.contains(&path.as_str())) else {
+            return Ok(());
+        };
+        let table = self.text[..key.start].trim_end().ends_with('[') || self.nodes.iter().any(|(p, _, _)| p.starts_with(&format!("{path}.")));
+        let (written, problem) = if table { (format!("[{path}]"), "unknown table") } else { (shorten(&self.text[value.clone()]), "unknown field") };
+        let expected = known.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
+        Err(DescriptionError::field_error(&self.file, Some(line_col(self.text, key.start).0), path.clone(), written, problem.to_string(), format!("expected one of {expected}")))
     }
 
     /// The field error of a failed deserialization: the field from the error's span, and the

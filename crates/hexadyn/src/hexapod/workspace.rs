@@ -3,7 +3,13 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use super::leg_kinematics::{LegKinematics, LegKinematicsError};
+use std::sync::Mutex;
+
+use super::leg_kinematics::{JointLimits, LegKinematics, LegKinematicsError};
+use super::pantograph::PantographGeometry;
+
+/// Workspaces remembered by [`LegKinematics::workspace`].
+pub const RECENT_WORKSPACES: usize = 64;
 
 impl LegKinematics {
 
@@ -77,7 +83,27 @@ impl LegKinematics {
 
     /// The workspace cylinder for foot heights [z_min, z_max] (leg frame): the largest
     /// vertical cylinder reachable at every height of the range (see the module docs).
+    ///
+    /// The last [`RECENT_WORKSPACES`] results are kept (a campaign or a sweep validates the same
+    /// walk many times; the search costs milliseconds).
     pub fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
+        type Recent = Vec<((PantographGeometry, Vector3<f64>, JointLimits, u64, u64), Result<Workspace, LegKinematicsError>)>;
+        static RECENT: Mutex<Recent> = Mutex::new(Vec::new());
+        let key = (self.pantograph, self.crossing, self.limits, z_min.to_bits(), z_max.to_bits());
+        if let Some((_, found)) = RECENT.lock().ok().and_then(|r| r.iter().find(|(k, _)| *k == key).cloned()) {
+            return found;
+        }
+        let result = self.search_workspace(z_min, z_max);
+        if let Ok(mut recent) = RECENT.lock() {
+            if recent.len() >= RECENT_WORKSPACES {
+                let _forgotten = recent.remove(0);
+            }
+            recent.push((key, result.clone()));
+        }
+        result
+    }
+
+    fn search_workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
         if !(z_min.is_finite() && z_max.is_finite()) {
             return Err(LegKinematicsError::NonFinite("workspace height range"));
         }

@@ -184,7 +184,7 @@ impl LinkConfig {
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self, ConfigError> {
         let path = path.as_ref();
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Io { file: file.clone(), reason: e.to_string() })?;
+        let text = crate::fields::read_input(path).map_err(|reason| ConfigError::Io { file: file.clone(), reason })?;
         Self::from_str(&text, &file)
     }
 

@@ -66,6 +66,12 @@ pub struct ContactForce {
 }
 
 impl GroundContact {
+    /// The penetration δ at rest under a normal force `f` (N): K δ^p_K = f (Eq. 3.72 without
+    /// its damping term).
+    pub fn static_penetration(&self, f: f64) -> f64 {
+        (f.max(0.0) / self.k_gnd).powf(1.0 / self.p_k)
+    }
+
     /// Contact force on a foot at `p` moving at `v` (the ground is fixed), Eq. 3.72-3.73.
     ///
     /// The penetration δ and the normal n are those of the closest point of the terrain to the

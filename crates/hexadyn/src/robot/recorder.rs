@@ -84,6 +84,27 @@ impl fmt::Display for RowMismatch {
 /// assert_eq!(series.len(), 3);
 /// assert_eq!(series.values("x"), Some(&[0.0, 2.0, 4.0][..]));
 /// ```
+///
+/// A long run is handed out in chunks ([`Recorder::take_chunk`]):
+///
+/// ```
+/// use hexadyn::robot::recorder::Recorder;
+/// let mut rec = Recorder::default();
+/// let mut chunks = Vec::new();
+/// for k in 0..5 {
+///     rec.begin_row();
+///     rec.put(k as f64, || ("t".into(), "s", "time".into()));
+///     rec.end_row();
+///     if rec.buffered() == 2 {
+///         chunks.push(rec.take_chunk());
+///     }
+/// }
+/// chunks.push(rec.take_chunk());
+/// let lengths: Vec<usize> = chunks.iter().map(|c| c.len()).collect();
+/// assert_eq!(lengths, [2, 2, 1]);
+/// assert_eq!(chunks[2].values("t"), Some(&[4.0][..]));
+/// assert_eq!(rec.rows(), 5);
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Recorder {
     series: TimeSeries,
@@ -133,5 +154,18 @@ impl Recorder {
 
     pub fn finish(self) -> TimeSeries {
         self.series
+    }
+
+    /// Rows recorded since the last [`Recorder::take_chunk`] (or the start).
+    pub fn buffered(&self) -> usize {
+        self.series.len()
+    }
+
+    /// Takes the rows recorded since the last call (the columns with their values so far) and
+    /// goes on recording into empty columns: a long run handed out in chunks holds one chunk at
+    /// a time.
+    pub fn take_chunk(&mut self) -> TimeSeries {
+        let columns = self.series.columns.iter_mut().map(|c| Column { name: c.name.clone(), unit: c.unit, description: c.description.clone(), values: std::mem::take(&mut c.values) }).collect();
+        TimeSeries { columns }
     }
 }

@@ -14,7 +14,7 @@ use serde::Deserialize;
 use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
 use super::terrain::{self, RawTerrain};
-use super::{joint_number, ControlMode, Initial, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
+use super::{joint_number, ControlMode, Initial, ModelFlags, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
 use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
@@ -92,6 +92,13 @@ struct RawModel {
     #[serde(default)]
     stand: bool,
     foot_load_kg: Option<Vec<f64>>,
+}
+
+impl RawScenario {
+    /// The `[model]` flags as written (defaults filled in).
+    pub(super) fn model_flags(&self) -> ModelFlags {
+        ModelFlags { friction: self.model.friction, load_dependence: self.model.load_dependence, inductance: self.model.inductance }
+    }
 }
 
 fn default_friction() -> FrictionModel {
@@ -201,6 +208,41 @@ struct RawMotion {
 // Validation
 // =============================================================================================
 
+// Documented ranges of the numerical settings (docs/scenario-format.md): outside them a run
+// is either meaningless or does not end in reasonable time.
+// INTERPRETATION: the thesis gives one value of each (Table 3.3, Section 4.4.3, the integrator
+// of Chapter 3); the ranges are chosen wide around them, bounded where the models stop being
+// valid (supply beyond twice the motors' rating, friction coefficients beyond any real
+// foot-ground pair) or the run stops being feasible (steps below 1e-5 s; tolerances below 1e-4,
+// where the validation walk already closes its energy balance to 0.007 % with 5 times the
+// steps of the robot's tolerance), and where the results lose their meaning (tolerance 1e3:
+// 12.8 % energy balance error).
+/// `model.k_gnd`: factors of the robot's ground stiffness.
+const RANGE_FACTOR_GROUND: [f64; 2] = [1e-3, 1e3];
+/// `model.mu`.
+const MU_RANGE: [f64; 2] = [0.0, 5.0];
+/// `model.supply_voltage_v`: the lower bound (V); the upper is twice the motor rating.
+const SUPPLY_MIN_V: f64 = 0.1;
+/// `integrator.tolerance`.
+const TOLERANCE_RANGE: [f64; 2] = [1e-4, 10.0];
+/// `integrator.h_max_s`: the smallest largest step (s).
+const H_MAX_MIN_S: f64 = 1e-5;
+
+/// Checks that `v` is a finite number in `[lo, hi]` (`unit` and `why` go into the message).
+fn in_range(c: &Ctx, field: &str, v: f64, [lo, hi]: [f64; 2], unit: &str, why: &str) -> Result<()> {
+    let unit = if unit.is_empty() { String::new() } else { format!(" {unit}") };
+    c.check(v >= lo && v <= hi, field, v, &format!("a number in [{}, {}]{unit}: {why}", readable(lo), readable(hi))).map_err(ScenarioError::from_parse)
+}
+
+/// A bound as a reader writes it: 0.1, 30, 1000, but 1e-4 and 1e9.
+fn readable(x: f64) -> String {
+    if x != 0.0 && (x.abs() >= 1e4 || x.abs() < 1e-3) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// Relative tolerance on stroke checks (a sawtooth written to the printed stroke ends passes).
 const STROKE_TOLERANCE: f64 = 1e-6;
 
@@ -217,7 +259,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     } else {
         let path: PathBuf = if Path::new(&h.robot).is_absolute() { PathBuf::from(&h.robot) } else { dir.join(&h.robot) };
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(&path).map_err(|err| {
+        let text = crate::fields::read_input(&path).map_err(|err| {
             e(c.err(
                 "scenario.robot",
                 format!("{:?}", h.robot),
@@ -240,16 +282,17 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
     model.load_dependence = m.load_dependence;
     model.inductance = m.inductance;
+    let ground = model.ground;
     if let Some(v) = m.k_gnd {
-        c.positive("model.k_gnd", v).map_err(e)?;
+        in_range(c, "model.k_gnd", v, RANGE_FACTOR_GROUND.map(|f| f * ground.k_gnd), "N/m^p_K", "ground stiffness within a factor 1000 of the robot's (Table 3.3): stiffer ground needs steps below the integrator's")?;
         model.ground.k_gnd = v;
     }
     if let Some(v) = m.d_gnd {
-        c.non_negative("model.d_gnd", v).map_err(e)?;
+        in_range(c, "model.d_gnd", v, [0.0, RANGE_FACTOR_GROUND[1] * ground.d_gnd], "N s/m^(p_D+1)", "ground damping up to 1000 times the robot's (Table 3.3)")?;
         model.ground.d_gnd = v;
     }
     if let Some(v) = m.mu {
-        c.non_negative("model.mu", v).map_err(e)?;
+        in_range(c, "model.mu", v, MU_RANGE, "", "a foot-ground friction coefficient (rubber on rough ground is below 1.5)")?;
         model.ground.mu = v;
     }
     if let Some(v) = m.foot_radius_m {
@@ -258,7 +301,8 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
     let terrain = terrain::validate(raw.terrain.as_ref(), c, dir).map_err(e)?;
     if let Some(v) = m.supply_voltage_v {
-        c.positive("model.supply_voltage_v", v).map_err(e)?;
+        let rated = robot.motor.nominal_voltage_v;
+        in_range(c, "model.supply_voltage_v", v, [SUPPLY_MIN_V, 2.0 * rated], "V", &format!("up to twice the motors' nominal voltage ({rated} V): the motor model has no limit beyond it"))?;
         model.supply_voltage = v;
     }
     model.stand = m.stand;
@@ -276,11 +320,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     // Integrator.
     let mut plant = PlantOptions::from_description(&robot, &model);
     if let Some(v) = raw.integrator.tolerance {
-        c.positive("integrator.tolerance", v).map_err(e)?;
+        in_range(c, "integrator.tolerance", v, TOLERANCE_RANGE, "", "the error estimate of Eq. 3.15 in units of the layout scales (the robot's is 1; 1e3 already leaves a 13 % energy balance error; 1e-4 takes 5 times the robot's steps for a balance error below 0.01 %, tighter only costs time)")?;
         plant.integrator.tolerance = v;
     }
     if let Some(v) = raw.integrator.h_max_s {
-        c.check(v > 0.0 && v <= period, "integrator.h_max_s", v, &format!("a step in (0, {period}] s (at most one control period)")).map_err(e)?;
+        c.check(v >= H_MAX_MIN_S && v <= period, "integrator.h_max_s", v, &format!("a step in [{H_MAX_MIN_S}, {period}] s (at most one control period; at least 1e-5 s, so that a control period takes at most 1000 steps)")).map_err(e)?;
         plant.integrator.h_max = v;
         plant.integrator.h_initial = plant.integrator.h_initial.min(v);
     }
@@ -495,7 +539,8 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
             let frequency_hz = required("frequency_hz", m.frequency_hz)?;
             let max = (hi - base).min(base - lo);
             c.check(amplitude.abs() <= max + tol, &field("amplitude"), amplitude, &format!("|amplitude| <= {max:.6} {unit} so that the reference stays in {stroke_text}"))?;
-            c.positive(&field("frequency_hz"), frequency_hz)?;
+            let nyquist = 0.5 / robot.controller.period_s;
+            c.check(frequency_hz > 0.0 && frequency_hz < nyquist, &field("frequency_hz"), frequency_hz, &format!("a frequency in (0, {nyquist}) Hz, below the Nyquist frequency of the control period ({} s)", robot.controller.period_s))?;
             JointMotion::Sine { amplitude, frequency_hz }
         }
         MotionKind::Sawtooth => {

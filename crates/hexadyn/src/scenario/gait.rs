@@ -367,12 +367,12 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
 
     // Strokes: every support stroke, |v_C| x support time, fits the workspace diameter.
     let support = patterns.iter().map(|p| cycle.support_fraction(p.beta)).fold(0.0, f64::max) * period_s;
+    // Only the instants where the heading can be largest are checked (a bounded number, not
+    // one per control period of a possibly very long run).
     let mut source = heading.source();
-    let steps = (duration / dt).round() as usize;
     let arms: Vec<f64> = (0..6).map(|l| legs[l].to_body(&workspaces[l].centre_at(-height)).xy().norm()).collect();
     let (mut worst, mut worst_t, mut worst_leg, mut worst_ratio) = (0.0f64, 0.0, 0, 0.0f64);
-    for k in 0..=steps {
-        let t = k as f64 * dt;
+    for t in source.extreme_times(duration, dt) {
         let h = source.heading(t);
         for l in 0..6 {
             // The largest |v + ω × r_C| over the yaw the body may have.

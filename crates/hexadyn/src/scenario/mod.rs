@@ -14,7 +14,8 @@
 //!   fields set from outside the file by dotted name ([`Scenario::from_file_with`],
 //!   [`Override`], e.g. `gait.heading.vx_m_s = 0.01`: the friction comparison and the Monte
 //!   Carlo campaigns run one file under many overrides);
-//! - `run.rs`: the run ([`run_scenario`], [`run_scenario_until`]);
+//! - `run.rs`: the run ([`run_scenario`], [`run_scenario_until`], and [`run_scenario_chunked`]
+//!   handing the time series out in chunks, for long runs streamed to disk);
 //! - `summary.rs`: what the run is reduced to ([`Summary`], [`GaitSummary`]).
 //!
 //! # Run and results
@@ -43,9 +44,9 @@ use serde::Deserialize;
 
 use crate::control::{GroundExperiment, JointMotion};
 use crate::description::RobotDescription;
-use crate::fields::{Ctx, DescriptionError, FieldError, SpanIndex};
+use crate::fields::{struct_fields, Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::{Joint, JOINTS};
-use crate::robot::model::ModelOptions;
+use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
 use crate::physics::Terrain;
 use crate::sim::SimError;
@@ -64,7 +65,7 @@ pub use gait::{FreeGaitSpec, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLE
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
-pub use run::{run_scenario, run_scenario_until, Record, ScenarioResults};
+pub use run::{run_scenario, run_scenario_chunked, run_scenario_until, Record, ScenarioResults};
 pub use summary::{specific_resistance, GaitSummary, Summary, SummaryValue};
 
 /// Name of the embedded default robot in `scenario.robot`.
@@ -200,6 +201,14 @@ fn joint_number(j: Joint) -> usize {
     }
 }
 
+/// The `[model]` flags of a scenario (the rest of [`ModelOptions`] comes from the robot).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ModelFlags {
+    pub friction: FrictionModel,
+    pub load_dependence: bool,
+    pub inductance: bool,
+}
+
 /// A validated scenario, SI units.
 #[derive(Clone, Debug)]
 pub struct Scenario {
@@ -234,7 +243,7 @@ impl Scenario {
     pub fn from_file(path: impl AsRef<Path>) -> Result<Scenario> {
         let path = path.as_ref();
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io { file: file.clone(), reason: e.to_string() })?;
+        let text = crate::fields::read_input(path).map_err(|reason| ScenarioError::Io { file: file.clone(), reason })?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Self::from_str(&text, &file, &dir)
     }
@@ -247,7 +256,7 @@ impl Scenario {
         }
         let path = path.as_ref();
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io { file: file.clone(), reason: e.to_string() })?;
+        let text = crate::fields::read_input(path).map_err(|reason| ScenarioError::Io { file: file.clone(), reason })?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let effective = overrides::apply(&text, &file, overrides)?;
         Self::from_str(&effective, &format!("{file} (with overrides)"), &dir).map_err(|e| overrides::locate(e, overrides))
@@ -258,9 +267,19 @@ impl Scenario {
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, origin: &str, dir: &Path) -> Result<Scenario> {
         let index = SpanIndex::build_for(text, origin, REFERENCE).map_err(ScenarioError::from_parse)?;
+        index.check_top_level(struct_fields::<file::RawScenario>()).map_err(ScenarioError::from_parse)?;
         let raw: file::RawScenario = toml::from_str(text).map_err(|e| ScenarioError::from_parse(index.serde_error(&e)))?;
         let c = Ctx { file: origin, index: Some(&index) };
         file::validate(&raw, &c, text, origin, dir)
+    }
+
+    /// The `[model]` flags of a scenario text, parsed as [`Scenario::from_str`] parses them,
+    /// without validating the rest (the robot file a stored scenario names may be gone):
+    /// what results saved before their metadata held the flags are read with.
+    pub fn model_flags(text: &str, origin: &str) -> Result<ModelFlags> {
+        let index = SpanIndex::build_for(text, origin, REFERENCE).map_err(ScenarioError::from_parse)?;
+        let raw: file::RawScenario = toml::from_str(text).map_err(|e| ScenarioError::from_parse(index.serde_error(&e)))?;
+        Ok(raw.model_flags())
     }
 
     /// The control period (s).

@@ -61,7 +61,8 @@ pub(super) fn apply(text: &str, origin: &str, overrides: &[Override]) -> Result<
         }
         table.insert(last.to_string(), o.value.clone());
     }
-    let listed: Vec<String> = overrides.iter().map(|o| format!("#   {} = {}", o.field, o.value)).collect();
+    // One comment line per override, whatever its text holds (a newline would end the comment).
+    let listed: Vec<String> = overrides.iter().map(|o| format!("#   {} = {}", o.field, o.value).replace(['\n', '\r'], " ")).collect();
     let body = toml::to_string(&doc).map_err(|e| ScenarioError::Io { file: origin.to_string(), reason: format!("cannot write the overridden scenario: {e}") })?;
     Ok(format!("# {origin} with overrides:\n{}\n{body}", listed.join("\n")))
 }

@@ -46,7 +46,37 @@ pub fn run_scenario(s: &Scenario, mut progress: impl FnMut(f64)) -> Result<Scena
 
 /// [`run_scenario`] keeping what `record` says, with a `progress` that may stop the run
 /// ([`ScenarioError::Stopped`]).
-pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
+pub fn run_scenario_until(s: &Scenario, record: Record, progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<ScenarioResults> {
+    let (rec, summary) = run(s, record == Record::TimeSeries, |_| ControlFlow::Continue(()), progress)?;
+    Ok(ScenarioResults { series: rec.finish(), summary })
+}
+
+/// [`run_scenario_until`] handing the time series out in chunks as the run goes, so that it
+/// never holds more than one chunk: `chunk` receives the first row alone (the columns are then
+/// known), then every `rows_per_chunk` rows, then the rest. A `chunk` that breaks stops the
+/// run ([`ScenarioError::Stopped`]). Returns the summary.
+pub fn run_scenario_chunked(s: &Scenario, rows_per_chunk: usize, mut chunk: impl FnMut(TimeSeries) -> ControlFlow<()>, progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<Summary> {
+    let rows_per_chunk = rows_per_chunk.max(1);
+    let (mut rec, summary) = run(
+        s,
+        true,
+        |rec| {
+            if rec.rows() == 1 || rec.buffered() >= rows_per_chunk {
+                chunk(rec.take_chunk())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+        progress,
+    )?;
+    if rec.buffered() > 0 && chunk(rec.take_chunk()).is_break() {
+        return Err(ScenarioError::Stopped { file: s.origin.clone(), t: s.duration });
+    }
+    Ok(summary)
+}
+
+/// The run: `recorded` rows go to a [`Recorder`], handed to `after_row` after each row.
+fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) -> ControlFlow<()>, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<(Recorder, Summary)> {
     let started = Instant::now();
     let sim_err = |stage: &'static str| move |source: SimError| ScenarioError::Simulation { file: s.origin.clone(), stage, source, hint: "" };
     let mut plant = settled_robot(s)?;
@@ -63,16 +93,17 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
     let mut last_t = 0.0;
     let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
         let state = gait_state.as_ref().map(|g| g.borrow());
-        if record == Record::TimeSeries {
-            let ground = ground.as_ref().map(|g| g.borrow());
-            record_row(&mut rec, p, meas, cmd, groups, state.as_deref(), ground.as_deref());
-        }
         stats.observe(p, cmd, supply, pi);
         if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
             let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
             gait_stats.observe(p.state().q.as_slice(), state, feet_down, &g.workspaces);
         }
         last_t = meas.t;
+        if recorded {
+            let ground = ground.as_ref().map(|g| g.borrow());
+            record_row(&mut rec, p, meas, cmd, groups, state.as_deref(), ground.as_deref());
+            after_row(&mut rec)?;
+        }
         progress(meas.t)
     })
     .map_err(sim_err("the simulation"))?;
@@ -80,12 +111,11 @@ pub fn run_scenario_until(s: &Scenario, record: Record, mut progress: impl FnMut
         return Err(ScenarioError::Stopped { file: s.origin.clone(), t: last_t });
     }
 
-    let series = rec.finish();
     let mut summary = summarize(s, &plant, &stats, &q, started.elapsed().as_secs_f64());
     if let (Some(g), Some(state)) = (&s.gait, &gait_state) {
         summary.gait = Some(GaitSummary::new(g, &gait_stats, &state.borrow().diagnostics));
     }
-    Ok(ScenarioResults { series, summary })
+    Ok((rec, summary))
 }
 
 /// The simulated robot at the start: feet on the ground, static equilibrium with the joints

@@ -72,6 +72,9 @@ pub struct Summary {
     pub max_tracking_error: Option<[f64; 3]>,
     /// Largest foot penetration into the ground.
     pub max_penetration_m: f64,
+    /// The penetration of three feet carrying the robot's weight at rest (Eq. 3.72): the scale
+    /// of [`Self::max_penetration_m`] on this ground (2.3 mm on the ground of Table 3.3).
+    pub static_penetration_m: f64,
     /// Walking figures, in gait mode.
     pub gait: Option<GaitSummary>,
 }
@@ -121,6 +124,7 @@ impl Summary {
             v.push(("max_tracking_error_q_h_m", Number(hh)));
         }
         v.push(("max_penetration_m", Number(self.max_penetration_m)));
+        v.push(("static_penetration_m", Number(self.static_penetration_m)));
         if let Some(g) = &self.gait {
             v.push(("gait_pattern", Text(g.pattern.clone())));
             v.push(("gait_cycle", Text(g.cycle.to_string())));
@@ -304,6 +308,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         limit_switch_cuts: stats.cuts,
         max_tracking_error: s.control.tracks_references().then_some(stats.tracking),
         max_penetration_m: stats.max_penetration,
+        static_penetration_m: s.model.ground.static_penetration(plant.robot.model.mechanics.model.total_mass() * crate::mbs::STANDARD_GRAVITY / 3.0),
         gait: None,
     }
 }

@@ -27,6 +27,25 @@ impl Heading {
 /// Where the heading velocities come from.
 pub trait HeadingSource: Send {
     fn heading(&mut self, t: f64) -> Heading;
+
+    /// Instants of the control grid k·dt in [0, end] among which the largest |v| + |Ω_z| r of
+    /// the run is found, for any arm r >= 0: few (independent of `end / dt`) where the heading
+    /// is piecewise linear in time, whose maximum of that convex function lies at a knot.
+    fn extreme_times(&self, end: f64, dt: f64) -> Vec<f64>;
+}
+
+/// The control instants k·dt on either side of each knot in [0, end], with the first and the
+/// last instant: a piecewise-linear heading takes its extremes there.
+fn instants_beside(knots: impl Iterator<Item = f64>, end: f64, dt: f64) -> Vec<f64> {
+    let last = (end / dt).round();
+    let mut ks: Vec<f64> = vec![0.0, last];
+    for knot in knots.filter(|&k| k >= 0.0 && k <= end) {
+        let k = knot / dt;
+        ks.extend([k.floor().clamp(0.0, last), k.ceil().clamp(0.0, last)]);
+    }
+    ks.sort_by(f64::total_cmp);
+    ks.dedup();
+    ks.into_iter().map(|k| k * dt).collect()
 }
 
 /// Constant heading velocities.
@@ -36,6 +55,10 @@ pub struct Constant(pub Heading);
 impl HeadingSource for Constant {
     fn heading(&mut self, _t: f64) -> Heading {
         self.0
+    }
+
+    fn extreme_times(&self, _end: f64, _dt: f64) -> Vec<f64> {
+        vec![0.0]
     }
 }
 
@@ -63,6 +86,10 @@ impl HeadingSource for Segments {
     fn heading(&mut self, t: f64) -> Heading {
         self.0.iter().take_while(|(start, _)| *start <= t).last().map_or(Heading::default(), |(_, h)| *h)
     }
+
+    fn extreme_times(&self, end: f64, dt: f64) -> Vec<f64> {
+        instants_beside(self.0.iter().map(|(start, _)| *start), end, dt)
+    }
 }
 
 /// A time series of headings, linearly interpolated, held constant beyond its ends.
@@ -87,7 +114,7 @@ impl Series {
     pub fn from_csv(path: &Path) -> Result<Self, SeriesError> {
         let file = path.display().to_string();
         let err = |line: usize, problem: String| SeriesError { file: file.clone(), line, problem };
-        let text = std::fs::read_to_string(path).map_err(|e| err(0, format!("cannot read: {e}")))?;
+        let text = crate::fields::read_input(path).map_err(|e| err(0, format!("cannot read: {e}")))?;
         let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
         let (n, header) = lines.next().ok_or_else(|| err(1, "empty file; expected the header t,vx,vy,omega_z".into()))?;
         let names: Vec<&str> = header.split(',').map(str::trim).collect();
@@ -131,6 +158,10 @@ impl HeadingSource for Series {
         let (a, b) = (&self.headings[i - 1], &self.headings[i]);
         let s = (t - self.t[i - 1]) / (self.t[i] - self.t[i - 1]);
         Heading { velocity: a.velocity + (b.velocity - a.velocity) * s, yaw_rate: a.yaw_rate + (b.yaw_rate - a.yaw_rate) * s }
+    }
+
+    fn extreme_times(&self, end: f64, dt: f64) -> Vec<f64> {
+        instants_beside(self.t.iter().copied(), end, dt)
     }
 }
 
@@ -178,7 +209,35 @@ impl HeadingSource for Spline {
         let yaw_rate = if speed2 > 0.0 { (dx * ddy - dy * ddx) / speed2 } else { 0.0 };
         Heading::new(dx, dy, yaw_rate)
     }
+
+    /// Between knots the heading is not linear: every control instant, but at most
+    /// [`SPLINE_SAMPLES`] evenly spread instants per knot interval.
+    fn extreme_times(&self, end: f64, dt: f64) -> Vec<f64> {
+        let knots = &self.x.t;
+        let mut times = instants_beside(knots.iter().copied(), end, dt);
+        for w in knots.windows(2) {
+            let (a, b) = (w[0].max(0.0), w[1].min(end));
+            let (ka, kb) = ((a / dt).ceil(), (b / dt).floor());
+            if kb < ka {
+                continue;
+            }
+            let n = kb - ka;
+            let stride = (n / SPLINE_SAMPLES as f64).ceil().max(1.0);
+            let mut k = ka;
+            while k <= kb {
+                times.push(k * dt);
+                k += stride;
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times
+    }
 }
+
+/// Samples per knot interval of the stride check on a spline path (the 50 s intervals of the
+/// built-in path at 100 Hz have 5000 instants: every 3rd is taken).
+pub const SPLINE_SAMPLES: usize = 2000;
 
 /// Natural cubic spline of one coordinate (second derivative zero at the ends).
 #[derive(Clone, Debug, PartialEq)]

@@ -1,0 +1,351 @@
+"""Robust under abuse (issue 17): Ctrl-C and kill -9 leave nothing behind, long runs are
+streamed to disk, names cannot choose a place, a BOM survives storing, settings outside their
+ranges and unhealthy runs are reported, and broken inputs give one line naming the file."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+from click.testing import CliRunner
+
+import hexadyn
+from hexadyn import _core, atomic, compare, health, report, runner
+from hexadyn.cli import INTERRUPTED, UNHEALTHY, cli
+
+from conftest import shortened
+
+HEXADYN = [sys.executable, "-m", "hexadyn.cli"]
+
+
+def scenario_text(shipped: str, **replace: str) -> str:
+    """A shipped scenario with whole lines `key = ...` replaced by `key = value`."""
+    text = (hexadyn.SCENARIOS_DIR / f"{shipped}.toml").read_text()
+    for key, value in replace.items():
+        text, n = re.subn(rf"(?m)^{key} = .*$", lambda _: f"{key} = {value}", text)
+        assert n == 1, key
+    return text
+
+
+def invoke(*args: str):
+    return CliRunner().invoke(cli, list(args), prog_name="hexadyn")
+
+
+def leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.rglob("*") if p.name.endswith((".partial", ".old")))
+
+
+# ---------------------------------------------------------------------------------------------
+# 1. Interruptible: Ctrl-C stops `hexadyn simulate` at once and writes nothing.
+# ---------------------------------------------------------------------------------------------
+
+
+def test_sigint_stops_a_long_run_and_leaves_nothing(tmp_path: Path):
+    """SIGINT at a random moment of a run of 1e4 s: exit 130 within 2 s with one line, no
+    results folder, no partial file."""
+    path = tmp_path / "long.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="1e4"))
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--no-plots"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    # Wait until the run has started (the progress bar), then a random moment more.
+    started = b""
+    while b"simulated" not in started:
+        chunk = proc.stderr.read1(4096)
+        assert chunk, f"the run did not start: {started.decode(errors='replace')}"
+        started += chunk
+    time.sleep(random.uniform(0.0, 1.5))
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    try:
+        out, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        raise
+    elapsed = time.monotonic() - sent
+    assert proc.returncode == INTERRUPTED, err.decode()
+    lines = [line for line in (started + err).decode().replace("\r", "\n").splitlines() if line.strip() and "simulated" not in line]
+    assert lines == ["Interrupted: nothing was written."], lines
+    assert "Traceback" not in err.decode()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["long.toml"] or not any((tmp_path / "results").iterdir())
+    assert leftovers(tmp_path) == []
+    assert elapsed < 2.0, f"exit {elapsed:.2f} s after SIGINT"
+
+
+def test_progress_callback_and_signals_are_polled_by_wall_clock(tmp_path: Path):
+    """A Python exception raised while the engine runs (here by the chunk sink) stops the run
+    and propagates as it was."""
+
+    class Stop(Exception):
+        pass
+
+    def sink(columns, units):
+        raise Stop()
+
+    with pytest.raises(Stop):
+        _core.run_scenario(str(shortened("stand_six_legs", tmp_path, 1.0)), chunk=sink)
+
+
+# ---------------------------------------------------------------------------------------------
+# 2. Streaming: the series goes to disk in chunks; runs too large are refused up front.
+# ---------------------------------------------------------------------------------------------
+
+
+def test_chunks_are_bit_identical_to_the_whole_series(tmp_path: Path):
+    path = str(shortened("leg_sine", tmp_path, 0.5))
+    whole = _core.run_scenario(path)
+    chunks = []
+
+    def keep(columns, units):
+        assert units == whole["units"]  # raised here, it would stop the run and propagate
+        chunks.append(columns)
+
+    raw = _core.run_scenario(path, chunk=keep, chunk_rows=9)
+    assert raw["columns"] == {} and list(raw["units"]) == list(whole["columns"])
+    assert [len(c["t"]) for c in chunks][:3] == [1, 9, 9]
+    for name, values in whole["columns"].items():
+        np.testing.assert_array_equal(np.concatenate([c[name] for c in chunks]), values)
+
+
+def test_saved_runs_stream_to_parquet_and_load_lazily(tmp_path: Path):
+    path = shortened("leg_sine", tmp_path, 0.5)
+    memory = hexadyn.simulate(path, progress=False)
+    saved = hexadyn.simulate(path, tmp_path / "out", progress=False)
+    assert saved.path == tmp_path / "out"
+    assert saved.shape == memory.timeseries.shape
+    loaded = hexadyn.Results.load(tmp_path / "out")
+    assert loaded._timeseries is None and loaded.shape == memory.timeseries.shape  # read on first access
+    np.testing.assert_array_equal(loaded.timeseries.to_numpy(), memory.timeseries.to_numpy())
+    assert list(loaded.timeseries.columns) == list(memory.timeseries.columns) and loaded.timeseries.index.name == "t"
+    assert loaded.read_columns(["Z"])["Z"].equals(memory.timeseries["Z"])
+    assert loaded.summary["warnings"] == [] and loaded.metadata["model"] == {"friction": "lugre", "load_dependence": False, "inductance": False}
+    assert json.loads(pq.read_schema(tmp_path / "out" / "timeseries.parquet").metadata[b"hexadyn"])["units"]["Z"] == "m"
+
+
+def test_a_series_too_long_for_memory_skips_the_in_memory_analysis(tmp_path: Path, monkeypatch):
+    monkeypatch.setattr(report, "IN_MEMORY_LIMIT_BYTES", 1000)
+    path = shortened("leg_sine", tmp_path, 0.3)
+    r = hexadyn.simulate(path, tmp_path / "out", progress=False, plots=True)
+    files = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert files == ["energy.csv", "metadata.json", "summary.json", "timeseries.parquet"]
+    assert "too long" in r.summary["analysis_skipped"]
+    # The energy figures come from the first and last row groups.
+    reference = hexadyn.simulate(path, progress=False)
+    assert r.summary["average_power_w"] == pytest.approx(reference.summary["average_power_w"], rel=1e-12)
+
+
+def test_runs_that_do_not_fit_are_refused_before_running(tmp_path: Path, monkeypatch):
+    path = shortened("stand_six_legs", tmp_path, 1e5)
+    monkeypatch.setattr(runner.shutil, "disk_usage", lambda p: type("Usage", (), {"free": 10_000_000})())
+    with pytest.raises(ValueError, match=r"about \d+\.\d GB \(10000001 instants x \d+ columns x 8 bytes\), more than the free space"):
+        hexadyn.simulate(path, tmp_path / "out", progress=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["stand_six_legs.toml"]
+    with pytest.raises(ValueError, match="more than memory .* pass out="):
+        hexadyn.simulate(path, progress=False)
+
+
+# ---------------------------------------------------------------------------------------------
+# 3. Ranges and health.
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "override, field",
+    [
+        ({"integrator.tolerance": 1e6}, "integrator.tolerance"),
+        ({"integrator.h_max_s": 1e-9}, "integrator.h_max_s"),
+        ({"model.supply_voltage_v": 1e6}, "model.supply_voltage_v"),
+        ({"model.mu": 1e9}, "model.mu"),
+        ({"model.k_gnd": 1e15}, "model.k_gnd"),
+    ],
+)
+def test_numerical_settings_out_of_range_name_the_field(override, field):
+    with pytest.raises(ValueError, match=re.escape(f"`{field}`")):
+        _core.load_scenario(str(hexadyn.SCENARIOS_DIR / "stand_six_legs.toml"), override)
+
+
+def test_health_checks_flag_meaningless_runs():
+    healthy = {
+        "energy_balance_error_relative": 0.001, "max_penetration_m": 0.002, "static_penetration_m": 0.0023, "initial_body_height_m": 0.4,
+        "body_height_change_m": -0.01, "tracking_error_xy_max_m": 0.01, "reference_distance_m": 0.9, "distance_walked_m": 0.89,
+    }  # fmt: skip
+    assert health.check(healthy) == []
+    for change, words in [
+        ({"energy_balance_error_relative": -0.128}, "energy balance error 12.80 %"),
+        ({"max_penetration_m": 0.05}, "50.0 mm into the ground, more than 3 x the 2.3 mm"),
+        ({"body_height_change_m": -0.3}, "the body fell by 300 mm"),
+        ({"tracking_error_xy_max_m": 1.0}, "strayed 1.000 m"),
+        ({"distance_walked_m": 282.0}, "walked 282.000 m for a 0.900 m reference"),
+        ({"energy_electrical_j": float("nan")}, "non-finite figures: energy_electrical_j"),
+    ]:
+        warnings = health.check({**healthy, **change})
+        assert len(warnings) == 1 and words in warnings[0], (change, warnings)
+
+
+def test_strict_turns_warnings_into_an_exit_status(tmp_path: Path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = shortened("stand_six_legs", tmp_path, 0.05)
+    result = invoke("simulate", str(path), "--no-progress", "--no-plots", "--strict")
+    assert result.exit_code == 0, result.output
+    monkeypatch.setattr(health, "MAX_PENETRATION_RATIO", 0.0)
+    for strict, status in [([], 0), (["--strict"], UNHEALTHY)]:
+        result = invoke("simulate", str(path), "--no-progress", "--no-plots", *strict)
+        assert result.exit_code == status and "WARNING: a foot went" in result.output, result.output
+    saved = json.loads(next((tmp_path / "results").glob("stand_six_legs-2")).joinpath("summary.json").read_text())
+    assert saved["warnings"] and "into the ground" in saved["warnings"][0]
+
+
+# ---------------------------------------------------------------------------------------------
+# 4. One text, one parser: a BOM survives the results folder.
+# ---------------------------------------------------------------------------------------------
+
+
+def test_a_scenario_with_a_byte_order_mark_is_stored_and_reloaded(tmp_path: Path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + scenario_text("stand_six_legs", duration_s="0.05", inductance="true").encode())
+    r = hexadyn.simulate(path, tmp_path / "out", progress=False)
+    loaded = hexadyn.Results.load(tmp_path / "out")
+    assert loaded.metadata["scenario"].startswith("\ufeff") and loaded.metadata["model"]["inductance"] is True
+    assert (report.energy.energy_breakdown(loaded)["magnetic_j"] != 0).any()
+    # Results saved before the flags were stored: the engine reads them from the stored text.
+    loaded.metadata.pop("model")
+    np.testing.assert_array_equal(report.energy.energy_breakdown(loaded)["magnetic_j"], report.energy.energy_breakdown(r)["magnetic_j"])
+
+
+def test_compare_reads_the_velocity_through_the_engine(tmp_path: Path):
+    path = tmp_path / "walk.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + (hexadyn.SCENARIOS_DIR / "validation_tripod_2cm.toml").read_bytes())
+    assert compare._scenario_velocity(path) == 0.02
+    assert compare._scenario_velocity(hexadyn.SCENARIOS_DIR / "path_spline.toml") is None
+
+
+def test_compare_friction_with_one_velocity_skips_the_fit(tmp_path: Path):
+    path = shortened("validation_tripod_1_5cm", tmp_path, 0.5)
+    result = invoke("compare-friction", str(path), "--velocities", "1.5", "--models", "none", "--out", str(tmp_path / "cmp"), "--no-progress", "--jobs", "1")
+    assert result.exit_code == 0, result.output
+    assert "averaged power of the q_r actuators" in result.output and "skipped: it needs at least two velocities" in result.output
+    assert (tmp_path / "cmp" / "fit.csv").read_text().strip() == "model,alpha_w,beta_n,xi_asymptote,mass_kg"
+
+
+# ---------------------------------------------------------------------------------------------
+# 5. Names are folder names, not paths.
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name, folder", [("/tmp/x", "_tmp_x"), ("../../../x", "_.._.._x"), ("..", "scenario"), ("a b\nc", "a_b_c"), ("stand", "stand")])
+def test_a_scenario_name_is_made_a_folder_name(tmp_path: Path, monkeypatch, name: str, folder: str):
+    monkeypatch.chdir(tmp_path)
+    assert runner.safe_folder_name(name) == folder
+    path = tmp_path / "s.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="0.02", name=json.dumps(name)))
+    result = invoke("simulate", str(path), "--no-progress", "--no-plots")
+    assert result.exit_code == 0, result.output
+    assert [p.name for p in (tmp_path / "results").iterdir()] == [folder]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results", "s.toml"]
+
+
+# ---------------------------------------------------------------------------------------------
+# 6. Stale partials of killed runs are removed by the next run in the same place.
+# ---------------------------------------------------------------------------------------------
+
+
+def test_a_run_killed_while_saving_leaves_a_partial_the_next_run_removes(tmp_path: Path):
+    """SIGKILL while the results folder is written (the series streams into it during the
+    whole run): a `.NAME.PID.*.partial` stays; the next run into the same folder removes it."""
+    path = tmp_path / "long.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="1e4"))
+    out = tmp_path / "out"
+    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--out", str(out / "a"), "--no-progress"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        while not any((out.iterdir() if out.is_dir() else [])):
+            assert proc.poll() is None, "the run ended before writing"
+            time.sleep(0.05)
+        time.sleep(random.uniform(0.1, 1.0))
+    finally:
+        proc.kill()
+        proc.wait()
+    stale = leftovers(out)
+    assert len(stale) == 1 and stale[0].startswith(f".a.{proc.pid}."), stale
+    # A live owner's partial is kept.
+    live = out / f".c.{os.getpid()}.abcdefgh.partial"
+    live.mkdir()
+    short = shortened("stand_six_legs", tmp_path, 0.02)
+    result = invoke("simulate", str(short), "--out", str(out / "b"), "--no-progress", "--no-plots")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in out.iterdir()) == [live.name, "b"]
+
+
+def test_stale_partial_files_are_recognised_by_their_owner():
+    assert atomic._owner(".specific_resistance.csv.1234.k2j3h4.partial") == 1234
+    assert atomic._owner(".a.b.99.x_y.old") == 99
+    for name in ["results", ".hidden", ".a.partial", ".a.xyz.abc.partial", "a.1.b.partial"]:
+        assert atomic._owner(name) is None, name
+
+
+# ---------------------------------------------------------------------------------------------
+# 7. Smaller rough edges.
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("saved")
+    hexadyn.simulate(shortened("stand_six_legs", folder, 0.05), folder / "run", progress=False)
+    return folder / "run"
+
+
+@pytest.mark.parametrize(
+    "file, content, words",
+    [
+        ("summary.json", "[1, 2]", "summary.json: a JSON list; expected an object"),
+        ("summary.json", "{broken", "summary.json: not valid JSON"),
+        ("metadata.json", '{"format": "hexadyn-results", "units": [1]}', "metadata.json: units is a list"),
+        ("metadata.json", "[]", "metadata.json: a JSON list"),
+        ("metadata.json", "\xff", "metadata.json: not valid JSON"),
+    ],
+)
+def test_broken_results_files_are_named_in_one_line(saved: Path, tmp_path: Path, file: str, content: str, words: str):
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    (broken / file).write_text(content, encoding="latin-1")
+    result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and words in result.output and "Traceback" not in result.output, result.output
+    assert len(result.output.strip().splitlines()) == 1
+
+
+def test_a_timeseries_directory_is_not_an_empty_table(saved: Path, tmp_path: Path):
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for name in ["metadata.json", "summary.json"]:
+        (broken / name).write_bytes((saved / name).read_bytes())
+    (broken / "timeseries.parquet").mkdir()
+    with pytest.raises(ValueError, match="timeseries.parquet: a directory"):
+        hexadyn.Results.load(broken)
+
+
+def test_override_values_that_toml_cannot_hold_name_the_field():
+    path = str(hexadyn.SCENARIOS_DIR / "stand_six_legs.toml")
+    with pytest.raises(ValueError, match=r"override model\.mu = 1180591620717411303424: out of range"):
+        _core.load_scenario(path, {"model.mu": 2**70})
+    # A newline in an override is a value like any other.
+    assert _core.load_scenario(path, {"scenario.name": "two\nlines"})["name"] == "two\nlines"
+    assert _core.load_scenario(path, {"scenario.description": "a\r\nb"})["description"] == "a\r\nb"
+
+
+def test_a_device_as_robot_file_fails_at_once(tmp_path: Path):
+    path = tmp_path / "s.toml"
+    path.write_text(scenario_text("stand_six_legs", robot='"/dev/zero"'))
+    with pytest.raises(ValueError, match="scenario.robot.*not a regular file"):
+        _core.load_scenario(str(path))
