@@ -144,11 +144,16 @@ def test_a_series_too_long_for_memory_skips_the_in_memory_analysis(tmp_path: Pat
 
 
 def test_runs_that_do_not_fit_are_refused_before_running(tmp_path: Path, monkeypatch):
+    # The engine's columns of this scenario ("t" included), from a run of one control period.
+    (tmp_path / "short").mkdir()
+    columns = len(_core.run_scenario(str(shortened("stand_six_legs", tmp_path / "short", 0.01)))["units"])
     path = shortened("stand_six_legs", tmp_path, 1e5)
     monkeypatch.setattr(runner.shutil, "disk_usage", lambda p: type("Usage", (), {"free": 10_000_000})())
-    with pytest.raises(ValueError, match=r"about \d+\.\d GB \(10000001 instants x \d+ columns x 8 bytes\), more than the free space"):
+    rows = 10_000_001  # 1e5 s at the 10 ms control period, both ends included
+    estimate = f"about {8 * rows * columns / 1e9:.1f} GB ({rows} instants x {columns} columns x 8 bytes), more than the free space of the disk of {tmp_path / 'out'} (10.0 MB)"
+    with pytest.raises(ValueError, match=re.escape(estimate)):
         hexadyn.simulate(path, tmp_path / "out", progress=False)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["stand_six_legs.toml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["short", "stand_six_legs.toml"]
     with pytest.raises(ValueError, match="more than memory .* pass out="):
         hexadyn.simulate(path, progress=False)
 
