@@ -255,6 +255,7 @@ class SeriesWriter:
         self._schema = None
         self._pending: list[list[Any]] = []  # chunks not written yet: one list of arrays per chunk, in schema order
         self._pending_rows = 0
+        self._group_rows = 1  # rows of a row group, from the number of columns (:meth:`_open`)
 
     def write_columns(self, columns: Mapping[str, Any]) -> None:
         """Appends a chunk: column name -> 1-D array, ``t`` among them. The arrays are kept as
@@ -312,7 +313,9 @@ class SeriesWriter:
     def __enter__(self) -> "SeriesWriter":
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        if exc_type is not None:  # the run failed: its file is discarded, what is pending with it
+            self._pending = []
         self.close()
 
 

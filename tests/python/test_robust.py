@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 from click.testing import CliRunner
@@ -168,6 +169,9 @@ def test_the_memory_of_a_streamed_run_does_not_grow_with_its_duration(tmp_path: 
     rows, columns = file.metadata.num_rows, file.metadata.num_columns
     assert rows == 10_001 and file.num_row_groups == 5
     np.testing.assert_allclose(file.read(columns=["t"]).column("t").to_numpy(), np.arange(rows) * 0.01, atol=1e-9)
+    # The first and the last instants, read a few columns at a time, are those of the whole file.
+    whole = file.read().to_pandas()
+    pd.testing.assert_frame_equal(hexadyn.Results.load(tmp_path / "100" / "out").endpoints(), whole.iloc[[0, -1]])
     # Held in memory, the 9000 instants more would take 8 x 9000 x columns bytes (22 MB; the peak
     # grows by 30 MB then); streamed, only the footer grows: 0.9 kB per column and row group
     # (1 MB here; the peak grows by about 5 MB).
