@@ -42,6 +42,8 @@ pub struct Data {
     /// Generalized forces applied directly on the configuration parameters.
     pub(crate) generalized: Vec<f64>,
     pub(crate) dual_work: Vec<Jet>,
+    /// (sin, cos) of each of [`Model::angles`] at this evaluation.
+    pub(crate) angles: Vec<(f64, f64)>,
     pub(crate) input_work: (Vec<f64>, Vec<f64>),
 }
 
@@ -74,6 +76,7 @@ impl Data {
             moment: vec![z; nb],
             generalized: vec![0.0; model.coordinates],
             dual_work: Vec::new(),
+            angles: vec![(0.0, 1.0); model.angles.len()],
             input_work: (Vec::new(), Vec::new()),
         }
     }

@@ -32,9 +32,9 @@ pub fn residual(model: &Model, data: &mut Data, qdd: &[f64], f: &mut [f64]) {
             alpha += data.delta_rel[body.own_offset + k] * qdd[c];
         }
         data.qdd_acceleration[i] = (a, alpha);
+        data.subtree[i] = (Vector3::zeros(), Vector3::zeros());
     }
     // Resultants over the subtrees, descendants first (a body comes after its reference body).
-    data.subtree.iter_mut().for_each(|w| *w = (Vector3::zeros(), Vector3::zeros()));
     for (i, body) in model.bodies.iter().enumerate().rev() {
         let (a, alpha) = data.qdd_acceleration[i];
         let phi = data.world_inertia[i];

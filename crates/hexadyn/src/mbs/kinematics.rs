@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::data::Data;
 use super::dependent;
-use super::model::{CompiledElementary, CompiledVar, Model, Source};
+use super::model::{CompiledElementary, CompiledVar, Model, Source, Var};
 use crate::spatial::Htm;
 
 /// Value, rate, convective second derivative and gradient (per compiled column) of a variable.
@@ -22,8 +22,7 @@ struct VarState {
     bias: f64,
 }
 
-fn var_state(var: &CompiledVar, q: &[f64], qd: &[f64], dependents: &[super::DependentValue]) -> VarState {
-    let v = &var.var;
+fn var_state(v: &Var, q: &[f64], qd: &[f64], dependents: &[super::DependentValue]) -> VarState {
     match v.source {
         Source::Coordinate(j) => VarState { value: v.scale * q[j] + v.offset, rate: v.scale * qd[j], bias: 0.0 },
         Source::Dependent(k) => {
@@ -95,6 +94,11 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
         dependent::evaluate(g.function.as_ref(), x, xd, out, &mut data.dual_work);
     }
     data.complete = false;
+    // Sine and cosine of each distinct joint angle, once (links moving in parallel, e.g. the
+    // pantograph's, turn by the same dependent parameter).
+    for (sc, var) in data.angles.iter_mut().zip(&model.angles) {
+        *sc = var_state(var, q, qd, &data.dependents).value.sin_cos();
+    }
     for (i, body) in model.bodies.iter().enumerate() {
         let (mut pose, mut omega, mut vel, mut alpha, mut acc) = match body.parent {
             Some(p) => (data.pose[p], data.omega[p], data.velocity[p], data.alpha_bias[p], data.accel_bias[p]),
@@ -107,39 +111,40 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
         let delta = &mut data.delta_rel[body.own_offset..body.own_offset + n];
         d.iter_mut().for_each(|x| *x = Vector3::zeros());
         delta.iter_mut().for_each(|x| *x = Vector3::zeros());
+        // Displacements are carried rigidly with ω, α and δ of the frame, which only a rotation
+        // changes: those up to the next rotation are summed and carried once (Eq. 3.24-3.27
+        // are linear in the displacement).
+        let mut displacement = Vector3::zeros();
         for e in &body.joint {
             match e {
                 CompiledElementary::Fixed(h) => {
-                    let r = pose.rotation * h.translation;
-                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
-                    pose.translation += r;
+                    displacement += pose.rotation * h.translation;
                     pose.rotation *= h.rotation;
                 }
-                CompiledElementary::Offset(t) => {
-                    let r = pose.rotation * t;
-                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
-                    pose.translation += r;
-                }
-                CompiledElementary::Rotation { axis, var } => {
-                    let s = var_state(var, q, qd, &data.dependents);
+                CompiledElementary::Offset(t) => displacement += pose.rotation * t,
+                CompiledElementary::Rotation { axis, var, angle } => {
+                    offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, d, delta);
+                    pose.translation += displacement;
+                    displacement = Vector3::zeros();
+                    let s = var_state(&var.var, q, qd, &data.dependents);
                     let e = axis.in_frame(&pose.rotation);
                     alpha += omega.cross(&e) * s.rate + e * s.bias;
                     omega += e * s.rate;
                     add_gradient(var, &data.dependents, &e, delta);
-                    axis.rotate(&mut pose.rotation, s.value.sin_cos());
+                    axis.rotate(&mut pose.rotation, data.angles[*angle]);
                 }
                 CompiledElementary::Translation { axis, var } => {
-                    let s = var_state(var, q, qd, &data.dependents);
+                    let s = var_state(&var.var, q, qd, &data.dependents);
                     let e = axis.in_frame(&pose.rotation);
-                    let r = e * s.value;
-                    offset_motion(&r, &omega, &alpha, &mut vel, &mut acc, d, delta);
+                    displacement += e * s.value;
                     vel += e * s.rate;
                     acc += omega.cross(&e) * (2.0 * s.rate) + e * s.bias;
                     add_gradient(var, &data.dependents, &e, d);
-                    pose.translation += r;
                 }
             }
         }
+        offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, d, delta);
+        pose.translation += displacement;
         data.world_inertia[i] = world_inertia(&pose.rotation, &body.inertia, body.principal.as_ref());
         data.pose[i] = pose;
         data.omega[i] = omega;

@@ -143,7 +143,9 @@ pub(crate) enum CompiledElementary {
     Fixed(Htm),
     /// A constant displacement T^d (Eq. A.1).
     Offset(Vector3<f64>),
-    Rotation { axis: Axis, var: CompiledVar },
+    /// `angle`: index of the variable in [`Model::angles`], whose sine and cosine are
+    /// evaluated once per kinematics.
+    Rotation { axis: Axis, var: CompiledVar, angle: usize },
     Translation { axis: Axis, var: CompiledVar },
 }
 
@@ -183,6 +185,8 @@ pub struct Model {
     pub(crate) dependent_count: usize,
     pub(crate) column_total: usize,
     pub(crate) own_total: usize,
+    /// The distinct variables of the rotations (see [`CompiledElementary::Rotation`]).
+    pub(crate) angles: Vec<Var>,
     /// Gravity acceleration in the global frame (m/s²).
     pub gravity: Vector3<f64>,
 }
@@ -298,6 +302,7 @@ impl ModelBuilder {
     pub fn build(self) -> Model {
         let mut bodies: Vec<Body> = Vec::with_capacity(self.specs.len());
         let (mut offset, mut own_offset) = (0, 0);
+        let mut angles: Vec<Var> = Vec::new();
         for spec in &self.specs {
             let mut own: Vec<usize> = Vec::new();
             for e in &spec.joint {
@@ -322,7 +327,13 @@ impl ModelBuilder {
                 match (e, joint.last_mut()) {
                     (Elementary::Fixed(h), Some(CompiledElementary::Fixed(previous))) => *previous = previous.compose(h),
                     (Elementary::Fixed(h), _) => joint.push(CompiledElementary::Fixed(*h)),
-                    (Elementary::Rotation { axis, var }, _) => joint.push(CompiledElementary::Rotation { axis: Axis::of(axis), var: compile(var) }),
+                    (Elementary::Rotation { axis, var }, _) => {
+                        let angle = angles.iter().position(|a| a == var).unwrap_or_else(|| {
+                            angles.push(*var);
+                            angles.len() - 1
+                        });
+                        joint.push(CompiledElementary::Rotation { axis: Axis::of(axis), var: compile(var), angle })
+                    }
                     (Elementary::Translation { axis, var }, _) => joint.push(CompiledElementary::Translation { axis: Axis::of(axis), var: compile(var) }),
                 }
             }
@@ -358,6 +369,7 @@ impl ModelBuilder {
             dependent_count: self.dependent_count,
             column_total: offset,
             own_total: own_offset,
+            angles,
             gravity: self.gravity,
         }
     }

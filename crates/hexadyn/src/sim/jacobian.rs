@@ -23,7 +23,8 @@ impl Jacobian {
     }
     /// The Newmark iteration matrix J = M + γh CT + βh² KT (Eq. 3.14).
     pub fn iteration_matrix(&self, beta: f64, gamma: f64, h: f64) -> DMatrix<f64> {
-        &self.m + &self.ct * (gamma * h) + &self.kt * (beta * h * h)
+        let (g, b) = (gamma * h, beta * h * h);
+        DMatrix::from_fn(self.m.nrows(), self.m.ncols(), |i, j| self.m[(i, j)] + self.ct[(i, j)] * g + self.kt[(i, j)] * b)
     }
     /// Exact blocks when the system provides them, finite differences otherwise.
     pub fn evaluate<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Self {

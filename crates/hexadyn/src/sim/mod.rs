@@ -3,6 +3,7 @@
 //! equilibrium and linearization (Eq. 3.16-3.17).
 
 mod error;
+mod factorization;
 mod jacobian;
 mod linearize;
 mod newmark;

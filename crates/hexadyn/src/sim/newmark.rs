@@ -1,8 +1,9 @@
 //! Implicit Newmark integration with Newton-Raphson on q''(t+h) (thesis Eq. 3.7-3.15).
 
-use nalgebra::{DMatrix, DVector, LU};
+use nalgebra::{DMatrix, DVector};
 
 use super::error::largest_rows;
+use super::factorization::Factorization;
 use super::jacobian::mass_matrix;
 use super::{Jacobian, Order, SimError, System};
 
@@ -97,11 +98,11 @@ pub struct Newmark {
     h: f64,
     jacobian: Option<Jacobian>,
     /// Factorization of J (Eq. 3.14) and the h it was built with.
-    lu: Option<(LU<f64, nalgebra::Dyn, nalgebra::Dyn>, f64)>,
+    lu: Option<(Factorization, f64)>,
     /// True when `jacobian` was evaluated during the current step (refreshing it again is useless).
     jacobian_fresh: bool,
     /// Factorization of M = ∂f/∂q'' kept for [`Self::reset_accelerations`].
-    mass_lu: Option<LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    mass_lu: Option<Factorization>,
     stats: NewmarkStats,
     work: Work,
 }
@@ -182,13 +183,11 @@ impl Newmark {
         if !direct {
             self.stats.jacobian_evaluations += 1;
         }
-        let lu = LU::new(m);
+        self.mass_lu = Factorization::new(m, &self.first_order(sys));
         self.stats.factorizations += 1;
-        if !lu.is_invertible() {
-            self.mass_lu = None;
+        if self.mass_lu.is_none() {
             return Ok(());
         }
-        self.mass_lu = Some(lu);
         self.consistent_accelerations(sys, 1.0)?;
         Ok(())
     }
@@ -206,7 +205,7 @@ impl Newmark {
             self.stats.residual_evaluations += 1;
             check_finite(sys, t, None, &self.work.f)?;
             let lu = self.mass_lu.as_ref().expect("factorized");
-            let Some(dx) = lu.solve(&DVector::from_column_slice(&self.work.f)) else {
+            let Some(dx) = lu.solve(&self.work.f) else {
                 return Ok(false);
             };
             self.state.qdd -= &dx;
@@ -285,13 +284,18 @@ impl Newmark {
         }
         let jac = self.jacobian.as_ref().expect("jacobian present");
         let matrix: DMatrix<f64> = jac.iteration_matrix(self.options.beta, self.options.gamma, h);
-        let lu = LU::new(matrix);
+        let first_order = self.first_order(sys);
         self.stats.factorizations += 1;
-        if !lu.is_invertible() {
+        let Some(lu) = Factorization::new(matrix, &first_order) else {
             return Err(SimError::Singular { what: "Newmark iteration", t: self.state.t });
-        }
+        };
         self.lu = Some((lu, h));
         Ok(())
+    }
+
+    /// Which coordinates are first-order states (candidates for the reduced factorization).
+    fn first_order<S: System + ?Sized>(&self, sys: &S) -> Vec<bool> {
+        sys.layout().orders.iter().map(|o| *o == Order::First).collect()
     }
 
     /// The Newton predictor of q''(t+h). Second-order coordinates: q''(t), the thesis' choice.
@@ -350,9 +354,8 @@ impl Newmark {
                 if self.work.f.iter().any(|x| !x.is_finite()) {
                     break;
                 }
-                let rhs = DVector::from_column_slice(&self.work.f);
                 let (lu, _) = self.lu.as_ref().expect("factorized");
-                let Some(dx) = lu.solve(&rhs) else { break };
+                let Some(dx) = lu.solve(&self.work.f) else { break };
                 self.work.qdd -= &dx;
                 let norm = test.norm(&dx, &self.work.weight_q);
                 if !norm.is_finite() {

@@ -1,0 +1,164 @@
+//! Factorization of the Newmark iteration matrix J (Eq. 3.14) and of M = ∂f/∂q'', reduced
+//! onto the coupled coordinates when some first-order states are decoupled from each other.
+//!
+//! First-order states such as the LuGre bristle deflections (Eq. 3.85) or the motor currents
+//! (Eq. 3.91) each depend on their own value and on the velocity of their joint only: ordering
+//! the coordinates as (a, t), t those states, J = [[A, B], [C, D]] with D diagonal and B, C
+//! sparse. J x = r is then solved exactly through the Schur complement S = A − B D⁻¹ C:
+//! S x_a = r_a − B D⁻¹ r_t, x_t = D⁻¹ (r_t − C x_a). For the 42-DOF model (24 multibody
+//! coordinates, 18 bristles) the LU is that of a 24 × 24 matrix instead of 42 × 42, about a
+//! fifth of the work, and each solve about half.
+
+use nalgebra::{DMatrix, DVector, Dyn, LU};
+
+/// A decoupled state is eliminated only when its diagonal entry is at least this fraction of
+/// the largest entry of its row and of its column: the pivot partial pivoting would also take
+/// first, so that the reduction is as accurate as the full LU.
+const PIVOT_DOMINANCE: f64 = 1e-3;
+
+/// LU factorization of J, on the Schur complement when first-order states can be eliminated.
+#[derive(Clone, Debug)]
+pub(crate) struct Factorization {
+    kind: Kind,
+}
+
+#[derive(Clone, Debug)]
+enum Kind {
+    Full(LU<f64, Dyn, Dyn>),
+    Reduced(Reduced),
+}
+
+#[derive(Clone, Debug)]
+struct Reduced {
+    /// Coordinates of the coupled block, and the eliminated states with their diagonal D.
+    a: Vec<usize>,
+    t: Vec<usize>,
+    d: Vec<f64>,
+    /// Non-zero entries of B (position in `a`, position in `t`, value) and of C (position in
+    /// `t`, position in `a`, value).
+    b: Vec<(usize, usize, f64)>,
+    c: Vec<(usize, usize, f64)>,
+    /// LU of S = A − B D⁻¹ C.
+    lu: LU<f64, Dyn, Dyn>,
+}
+
+impl Factorization {
+    /// Factorizes `j`, eliminating the `first_order` coordinates that are decoupled from every
+    /// other first-order coordinate and hold a dominant diagonal. None when J is singular.
+    pub(crate) fn new(j: DMatrix<f64>, first_order: &[bool]) -> Option<Self> {
+        let n = j.nrows();
+        let candidates: Vec<usize> = (0..n).filter(|&i| first_order[i]).collect();
+        let decoupled = |i: usize| {
+            let diagonal = j[(i, i)].abs();
+            let dominant = (0..n).all(|k| j[(i, k)].abs() * PIVOT_DOMINANCE <= diagonal && j[(k, i)].abs() * PIVOT_DOMINANCE <= diagonal);
+            diagonal > 0.0 && dominant && candidates.iter().all(|&k| k == i || (j[(i, k)] == 0.0 && j[(k, i)] == 0.0))
+        };
+        let t: Vec<usize> = candidates.iter().copied().filter(|&i| decoupled(i)).collect();
+        // Nothing to eliminate, or nothing left (a diagonal J): the full LU.
+        if t.is_empty() || t.len() == n {
+            let lu = LU::new(j);
+            return lu.is_invertible().then_some(Factorization { kind: Kind::Full(lu) });
+        }
+        let mut in_t = vec![false; n];
+        t.iter().for_each(|&i| in_t[i] = true);
+        let a: Vec<usize> = (0..n).filter(|&i| !in_t[i]).collect();
+        let d: Vec<f64> = t.iter().map(|&i| j[(i, i)]).collect();
+        let mut b = Vec::new();
+        let mut c = Vec::new();
+        // C row by row: those of row kt from c_start[kt].
+        let mut c_start = Vec::with_capacity(t.len() + 1);
+        for (kt, &ti) in t.iter().enumerate() {
+            c_start.push(c.len());
+            for (ka, &ai) in a.iter().enumerate() {
+                if j[(ai, ti)] != 0.0 {
+                    b.push((ka, kt, j[(ai, ti)]));
+                }
+                if j[(ti, ai)] != 0.0 {
+                    c.push((kt, ka, j[(ti, ai)]));
+                }
+            }
+        }
+        c_start.push(c.len());
+        let mut s = DMatrix::from_fn(a.len(), a.len(), |r, col| j[(a[r], a[col])]);
+        for &(ka, kt, bv) in &b {
+            let scale = bv / d[kt];
+            for &(_, cj, cv) in &c[c_start[kt]..c_start[kt + 1]] {
+                s[(ka, cj)] -= scale * cv;
+            }
+        }
+        let lu = LU::new(s);
+        lu.is_invertible().then_some(Factorization { kind: Kind::Reduced(Reduced { a, t, d, b, c, lu }) })
+    }
+
+    /// x with J x = r; None when the factorization cannot solve it.
+    pub(crate) fn solve(&self, r: &[f64]) -> Option<DVector<f64>> {
+        match &self.kind {
+            Kind::Full(lu) => lu.solve(&DVector::from_column_slice(r)),
+            Kind::Reduced(s) => {
+                // r_t / D, then S x_a = r_a − B D⁻¹ r_t.
+                let rt: Vec<f64> = s.t.iter().zip(&s.d).map(|(&i, d)| r[i] / d).collect();
+                let mut ra = DVector::from_iterator(s.a.len(), s.a.iter().map(|&i| r[i]));
+                for &(ka, kt, bv) in &s.b {
+                    ra[ka] -= bv * rt[kt];
+                }
+                let xa = s.lu.solve(&ra)?;
+                let mut x = DVector::zeros(r.len());
+                for (ka, &i) in s.a.iter().enumerate() {
+                    x[i] = xa[ka];
+                }
+                let mut xt: Vec<f64> = s.t.iter().map(|&i| r[i]).collect();
+                for &(kt, ka, cv) in &s.c {
+                    xt[kt] -= cv * xa[ka];
+                }
+                for (kt, &i) in s.t.iter().enumerate() {
+                    x[i] = xt[kt] / s.d[kt];
+                }
+                Some(x)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 5 × 5 system with two decoupled first-order states: the reduced solve is the full LU's
+    /// to rounding, and a coupled pair of first-order states is not eliminated.
+    #[test]
+    fn reduced_solve_matches_the_full_lu() {
+        let j = DMatrix::from_row_slice(5, 5, &[
+            4.0, 1.0, 0.5, 0.3, 0.0, //
+            1.0, 3.0, 0.2, 0.0, -0.7, //
+            0.5, 0.2, 5.0, 0.0, 0.0, //
+            0.9, 0.0, 0.0, 2.0, 0.0, //
+            0.0, -0.4, 0.0, 0.0, 1.5,
+        ]);
+        let r = [1.0, -2.0, 0.5, 3.0, -1.0];
+        let full = LU::new(j.clone()).solve(&DVector::from_column_slice(&r)).unwrap();
+        let first = [false, false, false, true, true];
+        let reduced = Factorization::new(j.clone(), &first).unwrap();
+        assert!(matches!(&reduced.kind, Kind::Reduced(s) if s.t == [3, 4]));
+        let x = reduced.solve(&r).unwrap();
+        assert!((&x - &full).amax() < 1e-14 * full.amax(), "{x} vs {full}");
+        assert!((&j * &x - DVector::from_column_slice(&r)).amax() < 1e-13);
+        // States 3 and 4 coupled to each other: neither is eliminated.
+        let mut coupled = j.clone();
+        coupled[(3, 4)] = 0.1;
+        let f = Factorization::new(coupled, &first).unwrap();
+        assert!(matches!(f.kind, Kind::Full(_)));
+        // Every coordinate decoupled (a diagonal J): the full LU, which solves it.
+        let diagonal = DMatrix::from_diagonal(&DVector::from_column_slice(&[2.0, 4.0]));
+        let f = Factorization::new(diagonal, &[true, true]).unwrap();
+        assert!(matches!(f.kind, Kind::Full(_)));
+        assert_eq!(f.solve(&[1.0, 1.0]).unwrap().as_slice(), &[0.5, 0.25]);
+    }
+
+    /// A singular matrix has no factorization, reduced or not.
+    #[test]
+    fn singular_is_none() {
+        let j = DMatrix::from_row_slice(3, 3, &[1.0, 2.0, 0.0, 2.0, 4.0, 0.0, 0.0, 0.0, 1.0]);
+        assert!(Factorization::new(j.clone(), &[false, false, true]).is_none());
+        assert!(Factorization::new(j, &[false; 3]).is_none());
+    }
+}
