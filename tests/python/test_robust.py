@@ -24,7 +24,7 @@ import hexadyn
 from hexadyn import _core, atomic, compare, health, report, runner
 from hexadyn.cli import INTERRUPTED, UNHEALTHY, cli
 
-from conftest import shortened
+from conftest import shortened, sigint_as_in_a_terminal
 
 HEXADYN = [sys.executable, "-m", "hexadyn.cli"]
 
@@ -57,7 +57,7 @@ def test_sigint_stops_a_long_run_and_leaves_nothing(tmp_path: Path):
     path = tmp_path / "long.toml"
     path.write_text(scenario_text("stand_six_legs", duration_s="1e4"))
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--no-plots"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--no-plots"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, preexec_fn=sigint_as_in_a_terminal)
     # Wait until the run has started (the progress bar), then a random moment more.
     started = b""
     while b"simulated" not in started:
