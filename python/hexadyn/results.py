@@ -42,6 +42,17 @@ IN_MEMORY_LIMIT_BYTES = 400 * 2**20
 #: Identifies a hexadyn results folder in metadata.json.
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
+#: The size of a row group of ``timeseries.parquet`` (8-byte values), and so about the memory
+#: a streamed run holds before writing. INTERPRETATION: the issue bounds the memory of a run,
+#: not the size of a row group. pyarrow's writer keeps about 0.9 kB of footer per column and
+#: row group until the file is closed (measured; 53 bytes each once written), 0.2 % of a
+#: row group this size: the one part of a streamed run's memory that grows with its duration
+#: (1e5 s of standing, 10^7 instants x 282 columns: 170 row groups, 43 MB of footer, against
+#: 250 MB with one row group per 10^4 instants). Twice the size halves the footer and doubles
+#: the buffer; readers favour row groups of 10^2 MB too.
+ROW_GROUP_BYTES = 128 * 2**20
+#: The most bytes of a row group read at a time for one row (:meth:`Results.endpoints`).
+ROW_READ_BYTES = 2 * 2**20
 
 __all__ = ["Results", "SeriesWriter", "TIMESERIES_FILE", "METADATA_FILE", "SUMMARY_FILE"]
 
@@ -150,17 +161,16 @@ class Results:
         return _read_parquet(self._series_file(), columns=list(columns))
 
     def endpoints(self) -> pd.DataFrame:
-        """The first and the last instant of the time series (two rows), read from the file's
-        first and last row group if the series is not in memory."""
+        """The first and the last instant of the time series (two rows), read from the file if
+        the series is not in memory (:func:`_read_row`: a few columns at a time)."""
         if self._timeseries is not None:
             return self._timeseries.iloc[[0, -1]]
-        import pandas as pd
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
         file = pq.ParquetFile(self._series_file())
-        first = file.read_row_group(0).slice(0, 1).to_pandas()
-        last_group = file.read_row_group(file.num_row_groups - 1)
-        return pd.concat([first, last_group.slice(last_group.num_rows - 1, 1).to_pandas()])
+        ends = pa.concat_tables([_read_row(file, 0, 0), _read_row(file, file.num_row_groups - 1, -1)])
+        return ends.to_pandas()
 
     def _series_file(self) -> Path:
         if self.path is None:
@@ -227,10 +237,15 @@ class Results:
 
 
 class SeriesWriter:
-    """Writes a time series to ``timeseries.parquet`` chunk by chunk, one row group per chunk
-    (pyarrow's ParquetWriter): a long run is streamed to disk as it goes. The file is read
-    back by :meth:`Results.load` as a DataFrame indexed by ``t``; the units are in the schema
-    metadata (key ``hexadyn``)."""
+    """Writes a time series to ``timeseries.parquet`` as it is recorded, in row groups of
+    about :data:`ROW_GROUP_BYTES` (pyarrow's ParquetWriter): a long run is streamed to disk as
+    it goes. The file is read back by :meth:`Results.load` as a DataFrame indexed by ``t``;
+    the units are in the schema metadata (key ``hexadyn``).
+
+    Memory: the chunks handed to :meth:`write_columns` are kept (without a copy) until they make
+    a row group, which is then written and dropped; the writer itself keeps the file footer
+    (see :data:`ROW_GROUP_BYTES`; statistics are written for ``t`` only, the column a reader
+    selects rows by)."""
 
     def __init__(self, path: Path, units: Mapping[str, str] | None = None) -> None:
         self.path = path
@@ -238,44 +253,86 @@ class SeriesWriter:
         self.rows = 0
         self._writer = None
         self._schema = None
+        self._pending: list[list[Any]] = []  # chunks not written yet: one list of arrays per chunk, in schema order
+        self._pending_rows = 0
+        self._group_rows = 1  # rows of a row group, from the number of columns (:meth:`_open`)
 
     def write_columns(self, columns: Mapping[str, Any]) -> None:
-        """Appends a chunk: column name -> array, ``t`` among them (after the first chunk, the
-        arrays go to Parquet without a copy through pandas)."""
-        import pyarrow as pa
-
-        if self._writer is None:
+        """Appends a chunk: column name -> 1-D array, ``t`` among them. The arrays are kept as
+        they are (not copied) until a row group is full."""
+        if self._schema is None:
             import pandas as pd
 
-            self.write_frame(pd.DataFrame(dict(columns)).set_index("t"))
-            return
-        self._writer.write_table(pa.Table.from_arrays([pa.array(columns[name]) for name in self._schema.names], schema=self._schema))
+            self._open(pd.DataFrame({name: values[:1] for name, values in columns.items()}).set_index("t"))
+        self._pending.append([columns[name] for name in self._schema.names])
+        self._pending_rows += len(columns["t"])
         self.rows += len(columns["t"])
+        if self._pending_rows >= self._group_rows:
+            self._flush()
 
     def write_frame(self, frame: pd.DataFrame) -> None:
-        """Appends a chunk indexed by ``t``."""
+        """Appends a chunk indexed by ``t`` (a series already in memory), in row groups of
+        about :data:`ROW_GROUP_BYTES`."""
+        import pyarrow as pa
+
+        if self._schema is None:
+            self._open(frame)
+        self._flush()
+        self._writer.write_table(pa.Table.from_pandas(frame, schema=self._schema, preserve_index=True), row_group_size=self._group_rows)
+        self.rows += len(frame)
+
+    def _open(self, frame: pd.DataFrame) -> None:
+        """Opens the file with the schema of `frame` (its pandas metadata makes ``t`` the index
+        when read back) and the units."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        if self._writer is None:
-            table = pa.Table.from_pandas(frame, preserve_index=True)
-            extra = json.dumps({"units": self.units, "hexadyn_version": __version__})
-            self._schema = table.schema.with_metadata({**(table.schema.metadata or {}), b"hexadyn": extra.encode()})
-            self._writer = pq.ParquetWriter(self.path, self._schema)
-        table = pa.Table.from_pandas(frame, schema=self._schema, preserve_index=True)
-        self._writer.write_table(table)
-        self.rows += len(frame)
+        schema = pa.Schema.from_pandas(frame, preserve_index=True)
+        extra = json.dumps({"units": self.units, "hexadyn_version": __version__})
+        self._schema = schema.with_metadata({**(schema.metadata or {}), b"hexadyn": extra.encode()})
+        self._group_rows = max(1, ROW_GROUP_BYTES // (8 * len(self._schema)))
+        self._writer = pq.ParquetWriter(self.path, self._schema, write_statistics=["t"])
+
+    def _flush(self) -> None:
+        """Writes the pending chunks as one row group."""
+        if not self._pending:
+            return
+        import pyarrow as pa
+
+        arrays = [pa.chunked_array([chunk[i] for chunk in self._pending], type=field.type) for i, field in enumerate(self._schema)]
+        rows, self._pending, self._pending_rows = self._pending_rows, [], 0
+        self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema), row_group_size=rows)
 
     def close(self) -> None:
+        """Writes what is pending and the footer."""
         if self._writer is not None:
+            self._flush()
             self._writer.close()
             self._writer = None
 
     def __enter__(self) -> "SeriesWriter":
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        if exc_type is not None:  # the run failed: its file is discarded, what is pending with it
+            self._pending = []
         self.close()
+
+
+def _read_row(file: Any, group: int, index: int) -> Any:
+    """Row `index` (negative: from the end) of row group `group` of a ParquetFile, as a
+    one-row pyarrow Table with the file's schema, read a block of columns at a time so that
+    at most about :data:`ROW_READ_BYTES` are decoded at once."""
+    import pyarrow as pa
+
+    names = file.schema_arrow.names
+    rows = file.metadata.row_group(group).num_rows
+    step = max(1, ROW_READ_BYTES // (8 * rows))
+    row = {}
+    for k in range(0, len(names), step):
+        block = file.read_row_group(group, columns=names[k : k + step], use_threads=False)
+        row.update((name, [block.column(name)[index % rows].as_py()]) for name in block.column_names)  # copies: a slice would keep the block
+    return pa.Table.from_pydict(row, schema=file.schema_arrow)
 
 
 def _read_parquet(path: Path, columns: list[str] | None = None) -> pd.DataFrame:

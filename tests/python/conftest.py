@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import signal
 from pathlib import Path
 from typing import Sequence
 
@@ -13,6 +14,14 @@ from matplotlib.image import imread
 
 import hexadyn
 from hexadyn import Results
+
+
+def sigint_as_in_a_terminal() -> None:
+    """``preexec_fn`` of a command that a test interrupts with SIGINT: it gets the default
+    disposition a command started from a terminal has. A test session started in the background
+    of a non-interactive shell (``&``, nohup) inherits SIGINT ignored, which its children keep
+    through exec, and Python then never raises KeyboardInterrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def shortened(name: str, folder: Path, duration: float = 0.2) -> Path:

@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 from scipy import stats
-from conftest import shortened
+from conftest import shortened, sigint_as_in_a_terminal
 
 from hexadyn import _core
 from hexadyn.cli import cli
@@ -204,7 +204,7 @@ def test_interrupted_campaign_resumes_without_loss_or_duplicate(reference, campa
 def test_killed_command_resumes(reference, scenario, tmp_path, sig):
     out = tmp_path / "killed"
     command = cli_command(scenario, out)
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_as_in_a_terminal)
     try:
         # Wait for the first stored run (bounded, so that a broken campaign cannot hang the tests).
         for _ in range(1200):

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 from click.testing import CliRunner
@@ -23,7 +24,7 @@ import hexadyn
 from hexadyn import _core, atomic, compare, health, report, runner
 from hexadyn.cli import INTERRUPTED, UNHEALTHY, cli
 
-from conftest import shortened
+from conftest import shortened, sigint_as_in_a_terminal
 
 HEXADYN = [sys.executable, "-m", "hexadyn.cli"]
 
@@ -56,7 +57,7 @@ def test_sigint_stops_a_long_run_and_leaves_nothing(tmp_path: Path):
     path = tmp_path / "long.toml"
     path.write_text(scenario_text("stand_six_legs", duration_s="1e4"))
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--no-plots"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    proc = subprocess.Popen([*HEXADYN, "simulate", str(path), "--no-plots"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, preexec_fn=sigint_as_in_a_terminal)
     # Wait until the run has started (the progress bar), then a random moment more.
     started = b""
     while b"simulated" not in started:
@@ -143,12 +144,52 @@ def test_a_series_too_long_for_memory_skips_the_in_memory_analysis(tmp_path: Pat
     assert r.summary["average_power_w"] == pytest.approx(reference.summary["average_power_w"], rel=1e-12)
 
 
+#: A child process: a standing run streamed to a results folder with row groups of 4 MiB (1859
+#: instants: a row group is written with every chunk of 2000 from the engine) and without the
+#: in-memory analysis; prints its peak resident memory (MB).
+STREAMED_RUN = """
+import resource, sys
+import hexadyn
+from hexadyn import report, results
+results.ROW_GROUP_BYTES = 4 * 2**20
+report.IN_MEMORY_LIMIT_BYTES = 0
+hexadyn.simulate(sys.argv[1], sys.argv[2], progress=False)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+"""
+
+
+def test_the_memory_of_a_streamed_run_does_not_grow_with_its_duration(tmp_path: Path):
+    peaks = {}
+    for duration in (10.0, 100.0):
+        folder = tmp_path / f"{duration:g}"
+        folder.mkdir()
+        done = subprocess.run([sys.executable, "-c", STREAMED_RUN, str(shortened("stand_six_legs", folder, duration)), str(folder / "out")], capture_output=True, text=True, check=True)
+        peaks[duration] = float(done.stdout.split()[-1])
+    file = pq.ParquetFile(tmp_path / "100" / "out" / "timeseries.parquet")
+    rows, columns = file.metadata.num_rows, file.metadata.num_columns
+    assert rows == 10_001 and file.num_row_groups == 5
+    np.testing.assert_allclose(file.read(columns=["t"]).column("t").to_numpy(), np.arange(rows) * 0.01, atol=1e-9)
+    # The first and the last instants, read a few columns at a time, are those of the whole file.
+    whole = file.read().to_pandas()
+    pd.testing.assert_frame_equal(hexadyn.Results.load(tmp_path / "100" / "out").endpoints(), whole.iloc[[0, -1]])
+    # Held in memory, the 9000 instants more would take 8 x 9000 x columns bytes (22 MB; the peak
+    # grows by 30 MB then); streamed, only the footer grows: 0.9 kB per column and row group
+    # (1 MB here; the peak grows by about 5 MB).
+    held = 8 * 9000 * columns / 2**20
+    assert peaks[100.0] - peaks[10.0] < 0.5 * held, f"peak memory {peaks} MB: grew by more than half the {held:.0f} MB of the longer series"
+
+
 def test_runs_that_do_not_fit_are_refused_before_running(tmp_path: Path, monkeypatch):
+    # The engine's columns of this scenario ("t" included), from a run of one control period.
+    (tmp_path / "short").mkdir()
+    columns = len(_core.run_scenario(str(shortened("stand_six_legs", tmp_path / "short", 0.01)))["units"])
     path = shortened("stand_six_legs", tmp_path, 1e5)
     monkeypatch.setattr(runner.shutil, "disk_usage", lambda p: type("Usage", (), {"free": 10_000_000})())
-    with pytest.raises(ValueError, match=r"about \d+\.\d GB \(10000001 instants x \d+ columns x 8 bytes\), more than the free space"):
+    rows = 10_000_001  # 1e5 s at the 10 ms control period, both ends included
+    estimate = f"about {8 * rows * columns / 1e9:.1f} GB ({rows} instants x {columns} columns x 8 bytes), more than the free space of the disk of {tmp_path / 'out'} (10.0 MB)"
+    with pytest.raises(ValueError, match=re.escape(estimate)):
         hexadyn.simulate(path, tmp_path / "out", progress=False)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["stand_six_legs.toml"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["short", "stand_six_legs.toml"]
     with pytest.raises(ValueError, match="more than memory .* pass out="):
         hexadyn.simulate(path, progress=False)
 

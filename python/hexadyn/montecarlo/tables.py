@@ -4,10 +4,12 @@ per velocity and friction variant) and Fig. 6.20 (means and +-3 sigma intervals 
 from __future__ import annotations
 
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from hexadyn import atomic
+
+if TYPE_CHECKING:  # pandas is imported when a table is made: the Ray workers import this package, not pandas
+    import pandas as pd
 
 __all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "write_table", "plot_specific_resistance"]
 
@@ -34,6 +36,8 @@ def specific_resistance_table(runs: pd.DataFrame, variants: tuple[str, ...]) -> 
     the specific resistance ξ = E/(m g l) (Eq. 6.6), mean - 3σ and mean + 3σ (Fig. 6.20), and the
     mean averaged power E/T (W, Fig. 6.19a).
     """
+    import pandas as pd
+
     rows = []
     for variant in variants:
         for _, group in runs[runs["variant"] == variant].groupby("velocity_index"):

@@ -100,6 +100,11 @@ pub fn ramp(angle: f64) -> Triangles {
     profile(&[-1.5, start, start + run, 3.5], &[0.0, 0.0, top, top], (-1.5, 2.5))
 }
 
+/// Radius around the origin within which [`rough`] ground is flat (m).
+pub const ROUGH_FLAT_RADIUS: f64 = 0.6;
+/// Radius beyond which [`rough`] ground has its full roughness (m).
+pub const ROUGH_FULL_RADIUS: f64 = 1.2;
+
 /// Rough ground: heights on a 0.1 m grid over x in [-2, 14] m, y in [-6, 6] m, a sum of 64
 /// cosine waves of random direction, wavelength in [0.3, 3] m and phase, drawn from `seed`,
 /// scaled to the RMS height `rms` (m), faded to flat ground within 0.6 m of the origin (smooth
@@ -122,7 +127,7 @@ pub fn rough(rms: f64, seed: u64) -> Triangles {
     // Each unit cosine has mean square 1/2: the sum of 64 has RMS 4 (independent phases).
     let scale = rms / (waves.len() as f64 / 2.0).sqrt();
     let fade = |r: f64| {
-        let u = ((r - 0.6) / 0.6).clamp(0.0, 1.0);
+        let u = ((r - ROUGH_FLAT_RADIUS) / (ROUGH_FULL_RADIUS - ROUGH_FLAT_RADIUS)).clamp(0.0, 1.0);
         u * u * (3.0 - 2.0 * u)
     };
     let (spacing, origin, (nx, ny)) = (0.1, [-2.0, -6.0], (161, 121));

@@ -18,12 +18,14 @@
 //!   angle-weighted pseudo-normals of its edges and vertices), from a PLY file ([`ply`]);
 //! - [`Heightfield`]: heights on a regular grid, its height under a point by the cell's triangle
 //!   and its contact through the mesh of those triangles;
-//! - [`generate`]: the seeded terrains the shipped scenarios use (a step, a ramp, rough ground).
+//! - [`generate`]: the seeded terrains the shipped scenarios use (a step, a ramp, rough ground);
+//! - [`classes`]: terrain classes (steps, slopes, rough ground by size) drawn from seeds.
 
 mod heightfield;
 mod mesh;
 mod step;
 
+pub mod classes;
 pub mod generate;
 pub mod ply;
 
