@@ -24,36 +24,22 @@ pub fn neighbours(failed: Option<usize>) -> [Option<(usize, usize)>; 6] {
     table
 }
 
-/// The legs that start their swing now: among the legs in support whose neighbours are in
-/// support (Rule 2), Rule 3 gives the priority to the lower kinematic margin: in order of
-/// increasing margin, a leg lifts unless a neighbour already lifts. `support[l]`: leg l is in
-/// its support phase; `margin[l]`: its kinematic margin (m) along the foot's motion in the leg
-/// frame. Two neighbours never lift together.
-///
-/// INTERPRETATION: the thesis states Rule 3 as "lift up the leg if its kinematic margin is
-/// lower than the one of its two neighbors" and adds that it "determines the leg to swing among
-/// the legs satisfying Rule 2", and that [PORT04] reaches the tripod "with rule 2 and some
-/// priority assignments on neighboring legs" (Section 7.2.2: the priority is the advance of the
-/// foot, i.e. its margin). The comparison is therefore made among the legs that satisfy Rule 2:
-/// a neighbour with a lower margin that cannot swing (one of its own neighbours is in the air)
-/// does not hold a leg back. Read literally (every neighbour compared), such a leg waits a whole
-/// step for nothing and the legs of a tripod drift apart into two-leg waves: 56.5 % of random
-/// starts reached the tripod, against the thesis' "converges to a tripod gait on flat ground".
+/// The legs that start their swing now: those in support whose neighbours are in support
+/// (Rule 2) and whose kinematic margin along the heading is lower than both neighbours' (Rule 3).
+/// `support[l]`: leg l is in its support phase; `margin[l]`: its kinematic margin (m) along the
+/// foot's motion in the leg frame. Two neighbours are never both candidates.
 ///
 /// INTERPRETATION: equal margins (feet placed symmetrically, e.g. all at their workspace centres
-/// at the start of a straight walk) are ordered by the leg number (the lower number first). A
-/// leg whose foot does not move (infinite margin: the robot stands still) never lifts.
+/// at the start of a straight walk) would leave no leg "lower than its two neighbours" and the
+/// robot deadlocked once they all reach their boundaries together; ties are broken by the leg
+/// number (the lower number is the lower margin). A leg whose foot does not move (infinite
+/// margin: the robot stands still) never lifts.
 pub fn swing_candidates(support: &[bool; 6], margin: &[f64; 6], neighbours: &[Option<(usize, usize)>; 6]) -> [bool; 6] {
-    let rule_2 = |l: usize| matches!(neighbours[l], Some((a, b)) if support[l] && support[a] && support[b] && margin[l].is_finite());
-    let mut order: Vec<usize> = (0..6).filter(|&l| rule_2(l)).collect();
-    order.sort_by(|&a, &b| margin[a].total_cmp(&margin[b]).then(a.cmp(&b)));
-    let mut lifting = [false; 6];
-    for l in order {
-        if let Some((a, b)) = neighbours[l] {
-            lifting[l] = !lifting[a] && !lifting[b];
-        }
-    }
-    lifting
+    let lower = |l: usize, n: usize| margin[l] < margin[n] || (margin[l] == margin[n] && l < n);
+    std::array::from_fn(|l| match neighbours[l] {
+        Some((a, b)) => support[l] && support[a] && support[b] && margin[l].is_finite() && lower(l, a) && lower(l, b),
+        None => false,
+    })
 }
 
 /// Section 7.7.4: the robot is deadlocked when a leg in support has reached the boundary of its
@@ -128,11 +114,6 @@ mod tests {
         let mut support = all;
         support[1] = false;
         assert_eq!(swing_candidates(&support, &margin, &t), [false, false, false, false, true, false]);
-        // Leg 0 (lowest margin) cannot swing with leg 1 in the air: it does not hold back its
-        // other neighbour, leg 2, whose own neighbours 0 and 4 are down (Rule 3 among the legs
-        // satisfying Rule 2); leg 4 then waits for leg 2 (lower margin).
-        let margin_2 = [0.01, 0.05, 0.02, 0.06, 0.03, 0.04];
-        assert_eq!(swing_candidates(&support, &margin_2, &t), [false, false, true, false, false, true]);
         // Leg 0 at its boundary and not lifting: deadlock.
         let lifting = swing_candidates(&support, &[0.0, 0.05, 0.06, 0.02, 0.03, 0.04], &t);
         assert!(deadlocked(&support, &[0.0, 0.05, 0.06, 0.02, 0.03, 0.04], &lifting, 1e-4));
