@@ -1,7 +1,8 @@
 """Regenerates the ``hexadyn view`` screenshots of the README (docs/view_*.png) in headless
-Chromium: the validation walk and the spline path of Section 7.5.3 with its reference.
+Chromium: the validation walk, the spline path of Section 7.5.3 with its reference, and a walk
+onto a step of the [terrain] table.
 
-    .venv/bin/python docs/view_screenshots.py [--results DIR]   # simulates the runs into DIR
+    .venv/bin/python docs/view_screenshots.py [--results DIR] [--only FILE ...]   # simulates the runs into DIR
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ DOCS = Path(__file__).resolve().parent
 SHOTS = [
     ("validation_tripod_1_5cm", "view_validation_walk.png", 33.0, (-0.35, -1.25, 0.95), (0.5, 0.0, 0.2)),
     ("path_spline", "view_path_spline.png", 120.0, (0.45, -2.2, 2.0), (0.8, -0.6, 0.0)),
+    ("tripod_low_step", "view_low_step.png", 42.0, (0.05, -1.1, 0.35), (0.6, 0.0, 0.1)),
 ]
 
 
@@ -51,6 +53,7 @@ def screenshot(folder: Path, png: Path, t: float, eye: tuple, target: tuple, bro
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, default=None, help="folder for the simulated runs (default: a temporary one)")
+    parser.add_argument("--only", action="append", default=[], metavar="FILE", help="regenerate only this screenshot (repeatable), e.g. view_low_step.png")
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
 
@@ -59,6 +62,8 @@ def main() -> None:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=["--use-angle=swiftshader", "--enable-unsafe-swiftshader"])
             for scenario, name, t, eye, target in SHOTS:
+                if args.only and name not in args.only:
+                    continue
                 folder = results / scenario
                 if not folder.exists():
                     hexadyn.simulate(scenario, out=folder, progress=False)

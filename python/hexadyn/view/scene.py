@@ -169,10 +169,11 @@ class RobotScene:
         crosses = [np.array([c - arm, c + arm]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
         crosses += [np.array([c - arm[::-1], c + arm[::-1]]) for c in np.column_stack([xs.ravel(), ys.ravel()])]
         scene.add_mesh_simple("/terrain", *_ribbons(crosses, 0.004, 0.0), color=GRID_COLOUR, cast_shadow=False, side="double")
-        # A ground that is not flat (a step, a slope, a mesh): its triangles, under the marks.
+        # A ground that is not flat (a step, a slope, a mesh): its triangles, under the marks,
+        # shaded per face so that a step's riser and a slope stand out from the level ground.
         surface = run.terrain((lo + hi) / 2, float(np.max(hi - lo)) / 2)
         if surface is not None:
-            scene.add_mesh_simple("/terrain/surface", *surface, color=TERRAIN_COLOUR, cast_shadow=False, side="double")
+            scene.add_mesh_simple("/terrain/surface", *surface, color=TERRAIN_COLOUR, flat_shading=True, cast_shadow=False, side="double")
         if len(keep) > 1:
             scene.add_mesh_simple("/paths/body", *_ribbons([path[keep, :2]], 0.01, 0.003), color=PATH_COLOUR, cast_shadow=False, side="double")
         if run.reference_xy is not None and len(keep) > 1:
