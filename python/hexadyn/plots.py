@@ -35,7 +35,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from hexadyn import energy, ground_detection
-from hexadyn.vocabulary import JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
+from hexadyn.vocabulary import FAILED, JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -71,6 +71,8 @@ REFERENCE = "0.25"
 SIMULATED = "#1f4e79"
 #: Shades of grey of the foot phases (Section 6.4: "different shades of gray"); support is white.
 PHASE_SHADES = {"double stance": "0.62", "takeoff": "0.78", "swing": "0.90", "landing": "0.70"}
+#: Colour of a failed leg (free gait on five legs) in the gait diagram.
+FAILED_COLOUR = "#e6a5a5"
 #: Colours of the stacked components.
 PHASE_COLOURS = {"support": "#1f4e79", "swing": "#8fb3d9", "transitions": "#e67e22"}
 ENERGY_COLOURS = {"joule_j": "#c0392b", "friction_j": "#7f8c8d", "mechanical_j": "#2e8b57", "magnetic_j": "#7d3c98"}
@@ -201,13 +203,16 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
 
 def gait_diagram(results: Results) -> Figure:
     """Gait diagram: for every leg, bars over the time it supports the body (black), its takeoff
-    and landing transitions (grey); the gaps are the swing phases."""
+    and landing transitions (grey), a failed leg held up by the free gait (light red); the gaps
+    are the swing phases."""
     phases = energy.foot_phases(results)
     if phases is None:
         raise ValueError("gait diagram: these results have no foot phases (not a walking scenario)")
     t = phases.index.to_numpy()
     dt = float(t[1] - t[0]) if len(t) > 1 else 0.0
     legend = {"support": ((SUPPORT,), "black"), "takeoff / landing": ((TAKEOFF, LANDING), "0.6")}
+    if (phases.to_numpy() == FAILED).any():
+        legend["failed, held up"] = ((FAILED,), FAILED_COLOUR)
     with style():
         fig = Figure(figsize=(6.3, 2.4))
         ax = fig.subplots()

@@ -14,6 +14,7 @@ from hexadyn import _core
 
 __all__ = [
     "ACTUATORS",
+    "FAILED",
     "JOINT_TYPES",
     "LANDING",
     "LEGS",
@@ -34,6 +35,8 @@ LEGS: tuple[int, ...] = tuple(range(_core.LEG_COUNT))
 #: Foot phase name -> code of the ``phase[l]`` columns.
 PHASE_CODES: dict[str, int] = dict(_core.PHASE_CODES)
 SUPPORT, TAKEOFF, SWING, LANDING = (PHASE_CODES[name] for name in ("support", "takeoff", "swing", "landing"))
+#: Code of a failed leg, held up by the free gait on five legs (beyond the thesis).
+FAILED = PHASE_CODES["failed"]
 
 
 def leg_column(quantity: str, leg: int) -> str:

@@ -114,3 +114,20 @@ def test_cli_simulate_and_plot(walk_file: Path, tmp_path: Path):
     result = runner.invoke(cli, ["simulate", str(walk_file), "--out", str(quiet), "--no-progress", "--no-plots"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
     assert not (quiet / "plots").exists() and (quiet / "power.csv").is_file()
+
+
+def test_gait_diagram_and_viewer_know_a_failed_leg(walk: Results):
+    """Phase code 4 (a failed leg held up by the free gait on five legs) has its own bar and
+    legend entry in the gait diagram, and its own level and colour in the viewer."""
+    from hexadyn import vocabulary
+    from hexadyn.view import charts, scene
+
+    ts = walk.timeseries.copy()
+    ts["phase[3]"] = float(vocabulary.FAILED)
+    five = Results(ts, walk.units, walk.summary, walk.metadata)
+    legend = [t.get_text() for t in plots.gait_diagram(five).axes[0].get_legend().get_texts()]
+    assert "failed, held up" in legend
+    assert "failed, held up" not in [t.get_text() for t in plots.gait_diagram(walk).axes[0].get_legend().get_texts()]
+    for code in vocabulary.PHASE_CODES.values():
+        assert code in charts.GAIT_LEVEL and code in scene.PHASE_COLOURS, code
+    assert len(set(scene.PHASE_COLOURS[c] for c in vocabulary.PHASE_CODES.values())) == len(vocabulary.PHASE_CODES)

@@ -21,7 +21,7 @@ def test_vocabulary_matches_the_recorded_columns(walk: Results):
         assert {a, *(vocabulary.actuator_column(q, a) for q in ("u", "i", "E_el", "E_joule", "E_fric"))} <= columns, a
     # The phase codes are those the engine describes its phase columns with.
     description = walk.descriptions[vocabulary.leg_column("phase", 0)]
-    assert vocabulary.PHASE_CODES == {"support": 0, "takeoff": 1, "swing": 2, "landing": 3}
+    assert vocabulary.PHASE_CODES == {"support": 0, "takeoff": 1, "swing": 2, "landing": 3, "failed": 4}
     for name, code in vocabulary.PHASE_CODES.items():
         assert f"{code} {name}" in description, (name, description)
 

@@ -4,6 +4,7 @@
 //! specific resistance of Eq. 6.6.
 
 use hexadyn::control::gait::pattern::FootPhase;
+use hexadyn::control::gait::schedule::FAILED_LEG_CODE;
 use hexadyn::description::RobotDescription;
 use hexadyn::hexapod::{Joint, LEG_COUNT};
 use pyo3::exceptions::PyValueError;
@@ -12,7 +13,8 @@ use pyo3::types::{PyDict, PyTuple};
 
 /// Adds `JOINT_NAMES` (the joint symbols in the thesis order, `("q_r", "q_v", "q_h")`),
 /// `LEG_COUNT` (6) and `PHASE_CODES` (foot phase name -> code of the `phase[l]` columns:
-/// support 0, takeoff 1, swing 2, landing 3) and the functions of this module.
+/// support 0, takeoff 1, swing 2, landing 3, and 4 for a failed leg held up by the free gait)
+/// and the functions of this module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("JOINT_NAMES", PyTuple::new(py, Joint::ALL.map(Joint::symbol))?)?;
@@ -22,6 +24,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         // The codes are small integers stored as floats in the time series.
         phases.set_item(phase.name(), phase.code() as u8)?;
     }
+    phases.set_item("failed", FAILED_LEG_CODE as u8)?;
     m.add("PHASE_CODES", phases)?;
     m.add_function(wrap_pyfunction!(robot_properties, m)?)?;
     m.add_function(wrap_pyfunction!(specific_resistance, m)?)?;

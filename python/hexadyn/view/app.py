@@ -23,6 +23,7 @@ import viser
 from hexadyn.view.charts import SignalCharts, gait_chart, signal_groups
 from hexadyn.view.data import LEGS, Frame, Run
 from hexadyn.view.scene import RobotScene
+from hexadyn.vocabulary import PHASE_CODES
 
 #: Playback speeds offered (simulated seconds per wall-clock second).
 SPEEDS = ("0.25", "0.5", "1", "2", "5", "10", "50")
@@ -182,11 +183,15 @@ class Viewer:
                     self.pause()
 
 
+#: Phase code -> name for the read-out (the free gait's failed leg included).
+PHASE_NAMES = {code: name for name, code in PHASE_CODES.items()}
+
+
 def _readout(frame: Frame) -> str:
     """The state read-out: a table for people, data attributes for scripts."""
     feet = frame.feet
     rows = "".join(
-        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{frame.forces[leg, 2]:.1f}</td><td>{int(frame.phases[leg])}</td></tr>"
+        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{frame.forces[leg, 2]:.1f}</td><td>{PHASE_NAMES.get(int(frame.phases[leg]), "")}</td></tr>"
         for leg in range(LEGS)
     )
     attributes = f'data-t="{frame.t!r}" data-index="{frame.index}" data-feet="{html.escape(json.dumps(feet.tolist()))}"'

@@ -14,13 +14,17 @@ import viser
 import viser.uplot
 
 from hexadyn.view.data import JOINTS, LEGS, Run, decimation
+from hexadyn.vocabulary import FAILED, LANDING, SUPPORT, SWING, TAKEOFF
 
 #: Most samples per chart (the panel is a few hundred pixels wide).
 PLOT_POINTS = 800
 CURSOR_COLOUR = "#d0206f"
 SERIES_COLOURS = ("#1f5fbf", "#2a9d3a", "#c0392b", "#8e44ad", "#e67e22", "#16a085")
-#: Height of a gait diagram bar per phase code (0 support, 1 takeoff, 2 swing, 3 landing).
-GAIT_LEVEL = {0: 0.7, 1: 0.35, 2: 0.0, 3: 0.35}
+#: Height of a gait diagram bar per phase code (support high, swing low, takeoff and landing half
+#: way); a failed leg held up (free gait on five legs) is drawn half way too, dashed.
+GAIT_LEVEL = {SUPPORT: 0.7, TAKEOFF: 0.35, SWING: 0.0, LANDING: 0.35, FAILED: 0.35}
+#: Dash pattern (pixels) of a failed leg's line in the gait diagram.
+FAILED_DASH = (3.0, 4.0)
 
 
 #: The series of one chart: (label, terms) pairs for a leg and a joint; terms as in _evaluate.
@@ -65,12 +69,15 @@ def _evaluate(run: Run, terms: tuple[str, ...], rows: np.ndarray) -> np.ndarray:
 class Chart:
     """One uPlot chart of decimated signals with a time cursor."""
 
-    def __init__(self, gui: viser.GuiApi, title: str, t: np.ndarray, series: list[tuple[str, np.ndarray]], height: int, y_range: tuple[float, float] | None = None):
+    def __init__(self, gui: viser.GuiApi, title: str, t: np.ndarray, series: list[tuple[str, np.ndarray]], height: int, y_range: tuple[float, float] | None = None, dashed: frozenset[str] = frozenset()):
         self.t = t
         self.values = [v for _, v in series]
         self._range = np.array(y_range) if y_range is not None else np.array([np.nanmin(self.values), np.nanmax(self.values)])
         configs = [viser.uplot.Series(label="t (s)")]
-        configs += [viser.uplot.Series(label=label, stroke=SERIES_COLOURS[i % len(SERIES_COLOURS)], width=1.5) for i, (label, _) in enumerate(series)]
+        configs += [
+            viser.uplot.Series(label=label, stroke=SERIES_COLOURS[i % len(SERIES_COLOURS)], width=1.5, **({"dash": FAILED_DASH} if label in dashed else {}))
+            for i, (label, _) in enumerate(series)
+        ]
         configs.append(viser.uplot.Series(label="now", stroke=CURSOR_COLOUR, width=1.5))
         scales = {"x": viser.uplot.Scale(time=False, auto=False, range=(float(t[0]), float(t[-1])))}
         if y_range is not None:
@@ -122,9 +129,13 @@ class SignalCharts:
 
 def gait_chart(gui: viser.GuiApi, run: Run) -> Chart:
     """The gait diagram: one bar per leg (leg 0 on top), high in support, low in swing, half way
-    during takeoff and landing."""
+    during takeoff and landing; a failed leg (free gait on five legs) is a dashed line half way,
+    labelled "(failed)"."""
     rows = decimation(run.t.size, PLOT_POINTS)
     phases = run.phases[rows]
     levels = np.vectorize(lambda p: GAIT_LEVEL.get(int(p), 0.0))(phases)
-    series = [(f"leg {leg}", (LEGS - 1 - leg) + levels[:, leg]) for leg in range(LEGS)]
-    return Chart(gui, "Gait diagram (high: support, low: swing), legs 0-5 top to bottom", run.t[rows], series, height=200, y_range=(-0.2, LEGS))
+    failed = (phases == FAILED).any(axis=0)
+    series = [(f"leg {leg}" + (" (failed)" if failed[leg] else ""), (LEGS - 1 - leg) + levels[:, leg]) for leg in range(LEGS)]
+    dashed = frozenset(label for (label, _), f in zip(series, failed) if f)
+    title = "Gait diagram (high: support, low: swing, dashed: failed leg held up), legs 0-5 top to bottom"
+    return Chart(gui, title, run.t[rows], series, height=200, y_range=(-0.2, LEGS), dashed=dashed)

@@ -14,13 +14,15 @@ import viser
 from viser import transforms as tf
 
 from hexadyn.view.data import LEGS, Frame, Run, decimation
+from hexadyn.vocabulary import FAILED, LANDING, SUPPORT, SWING, TAKEOFF
 
 #: Colours (RGB 0-255).
 BODY_COLOUR = (70, 90, 120)
 CHASSIS_COLOUR = (120, 130, 145)
 LINK_COLOURS = ((205, 160, 60), (150, 150, 150), (150, 150, 150), (215, 120, 40))
-#: Foot colour per phase code (0 support, 1 takeoff, 2 swing, 3 landing) and without a gait.
-PHASE_COLOURS = {0: (30, 30, 30), 1: (240, 170, 0), 2: (230, 60, 40), 3: (40, 150, 230), -1: (30, 30, 30)}
+#: Foot colour per phase code (support, takeoff, swing, landing, a failed leg held up by the free
+#: gait) and without a gait (-1).
+PHASE_COLOURS = {SUPPORT: (30, 30, 30), TAKEOFF: (240, 170, 0), SWING: (230, 60, 40), LANDING: (40, 150, 230), FAILED: (160, 160, 160), -1: (30, 30, 30)}
 PATH_COLOUR = (20, 50, 200)
 GRID_COLOUR = (150, 150, 150)
 TERRAIN_COLOUR = (185, 170, 140)

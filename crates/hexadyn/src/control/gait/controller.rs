@@ -9,6 +9,7 @@
 use nalgebra::Vector3;
 
 use super::body_motion::{BodyMotion, Pose};
+use super::walk::{LegState, Walk};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
 use crate::control::{BodyPose, Command, Controller, DigitalPi, Measurements};
@@ -44,7 +45,7 @@ pub struct GaitOptions {
 
 /// The state of one leg.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Leg {
+pub struct Leg {
     phase: FootPhase,
     /// Anchor point {p_F/0}_0 of the support (Eq. 7.10), or the virtual one of the landing.
     anchor: Vector3<f64>,
@@ -77,8 +78,7 @@ pub struct GaitController {
     workspaces: [Workspace; 6],
     pis: [DigitalPi; JOINTS],
     heading: Box<dyn HeadingSource>,
-    body: Option<BodyMotion>,
-    legs: [Leg; 6],
+    walk: Walk<Leg>,
     /// Time of the gait's origin (phase 0 of the pattern).
     origin: f64,
     pending: Option<GaitPattern>,
@@ -88,26 +88,9 @@ pub struct GaitController {
 impl GaitController {
     pub fn new(options: GaitOptions, legs: [LegKinematics; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
         let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), swing_time: 0.0, foot: Vector3::zeros(), joints: Vector3::zeros() };
-        GaitController { options, legs_kinematics: legs, workspaces, pis, heading, body: None, legs: [idle; 6], origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
+        GaitController { options, legs_kinematics: legs, workspaces, pis, heading, walk: Walk { body: None, legs: [idle; 6] }, origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
     }
 
-    /// Phase of each foot at the last update (for gait diagrams and the ≥ 3 feet check).
-    pub fn phases(&self) -> [FootPhase; 6] {
-        self.legs.map(|l| l.phase)
-    }
-    /// The desired body pose T*_{0,b} at the last update.
-    pub fn desired_pose(&self) -> Option<Pose> {
-        self.body.as_ref().map(|b| b.pose)
-    }
-    /// The desired body velocity v*_{b/0} and angular velocity ω*_{b/0} (global frame) at the
-    /// last update.
-    pub fn desired_velocity(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
-        self.body.as_ref().map(|b| (b.velocity(), b.omega()))
-    }
-    /// Foot references in the leg frames at the last update.
-    pub fn foot_references(&self) -> [Vector3<f64>; 6] {
-        self.legs.map(|l| l.foot)
-    }
     pub fn workspaces(&self) -> &[Workspace; 6] {
         &self.workspaces
     }
@@ -139,15 +122,15 @@ impl GaitController {
         for l in 0..6 {
             let q = joints_of(m, l);
             let foot = self.legs_kinematics[l].foot(&q);
-            self.legs[l].foot = foot;
-            self.legs[l].joints = q;
-            self.legs[l].anchor = self.leg_frame(l, &htm).apply(&foot);
+            self.walk.legs[l].foot = foot;
+            self.walk.legs[l].joints = q;
+            self.walk.legs[l].anchor = self.leg_frame(l, &htm).apply(&foot);
         }
-        let level = self.legs.iter().map(|l| l.anchor.z).sum::<f64>() / 6.0;
-        for leg in &mut self.legs {
+        let level = self.walk.legs.iter().map(|l| l.anchor.z).sum::<f64>() / 6.0;
+        for leg in &mut self.walk.legs {
             leg.anchor.z = level;
         }
-        self.body = Some(BodyMotion::new(pose));
+        self.walk.body = Some(BodyMotion::new(pose));
         self.origin = m.t;
     }
 
@@ -190,7 +173,7 @@ impl GaitController {
 
     /// Switches to the pending pattern when all feet are down.
     fn try_switch(&mut self, t: f64) {
-        if self.pending.is_none() || self.legs.iter().any(|l| l.phase != FootPhase::Support) {
+        if self.pending.is_none() || self.walk.legs.iter().any(|l| l.phase != FootPhase::Support) {
             return;
         }
         let next = self.pending.take().expect("pending");
@@ -294,15 +277,15 @@ pub(super) fn centre_velocity(kin: &LegKinematics, c_leg: &Vector3<f64>, frame: 
 impl Controller for GaitController {
     fn update(&mut self, m: &Measurements) -> Command {
         let h = self.heading.heading(m.t);
-        if self.body.is_none() {
+        if self.walk.body.is_none() {
             self.start(m);
         } else {
             // Eq. 7.12-7.23: the desired body HTM from the heading velocities.
             let dt = self.options.dt;
-            self.body.as_mut().expect("started").step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), dt);
+            self.walk.body.as_mut().expect("started").step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), dt);
         }
         self.try_switch(m.t);
-        let body = self.body.clone().expect("started");
+        let body = self.walk.body.clone().expect("started");
         let desired = body.pose.htm();
         let estimated = self.estimated_pose(m, &body.pose);
         let o = self.options.clone();
@@ -312,7 +295,7 @@ impl Controller for GaitController {
         for l in 0..6 {
             let phi = o.pattern.phase(l, m.t - self.origin, o.period);
             let mut target = o.cycle.phase(phi, beta);
-            let leg = self.legs[l];
+            let leg = self.walk.legs[l];
             // While a new gait is pending, no foot leaves the ground.
             if self.pending.is_some() && leg.phase == FootPhase::Support {
                 target = FootPhase::Support;
@@ -392,11 +375,27 @@ impl Controller for GaitController {
                 self.diagnostics.last_clamped_at = Some(m.t);
             }
             next.joints = ik.joints;
-            self.legs[l] = next;
+            self.walk.legs[l] = next;
             references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
         }
         let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
         Command { voltages, references }
+    }
+}
+
+impl LegState for Leg {
+    fn phase(&self) -> FootPhase {
+        self.phase
+    }
+    fn foot(&self) -> Vector3<f64> {
+        self.foot
+    }
+}
+
+impl std::ops::Deref for GaitController {
+    type Target = Walk<Leg>;
+    fn deref(&self) -> &Walk<Leg> {
+        &self.walk
     }
 }
 

@@ -10,3 +10,4 @@ pub mod free;
 pub mod heading;
 pub mod pattern;
 pub mod schedule;
+pub mod walk;

@@ -17,6 +17,7 @@ use super::posture::{ground_plane, solve_posture, PostureCorrection};
 use super::rules::{deadlocked, neighbours, stability_margin, swing_candidates};
 use super::velocity::corrected_velocities;
 use crate::control::gait::body_motion::{BodyMotion, Pose};
+use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
@@ -61,7 +62,7 @@ pub struct FreeGaitOptions {
 
 /// The state of one leg.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Leg {
+pub struct Leg {
     phase: FootPhase,
     /// Anchor {p_F/0}_0 of the support (Eq. 7.10); in the air, the last contact point (used by
     /// Eq. 7.32); during the landing, the virtual anchor of the descending foot.
@@ -105,8 +106,7 @@ pub struct FreeGaitController {
     heading: Box<dyn HeadingSource>,
     landing: Box<dyn LandingDetector>,
     neighbours: [Option<(usize, usize)>; 6],
-    body: Option<BodyMotion>,
-    legs: [Leg; 6],
+    walk: Walk<Leg>,
     /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
     posture: (Vector3<f64>, f64),
     state: FreeGaitState,
@@ -133,26 +133,13 @@ impl FreeGaitController {
             heading,
             landing,
             neighbours,
-            body: None,
-            legs: [idle; 6],
+            walk: Walk { body: None, legs: [idle; 6] },
             posture: (z, f64::NEG_INFINITY),
             state: FreeGaitState::default(),
             diagnostics: GaitDiagnostics::default(),
         }
     }
 
-    pub fn phases(&self) -> [FootPhase; 6] {
-        self.legs.map(|l| l.phase)
-    }
-    pub fn desired_pose(&self) -> Option<Pose> {
-        self.body.as_ref().map(|b| b.pose)
-    }
-    pub fn desired_velocity(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
-        self.body.as_ref().map(|b| (b.velocity(), b.omega()))
-    }
-    pub fn foot_references(&self) -> [Vector3<f64>; 6] {
-        self.legs.map(|l| l.foot)
-    }
     pub fn state(&self) -> FreeGaitState {
         self.state
     }
@@ -184,9 +171,9 @@ impl FreeGaitController {
             let foot = self.legs_kinematics[l].foot(&q);
             let anchor = self.leg_frame(l, &htm).apply(&foot);
             let phase = if self.working(l) { FootPhase::Support } else { FootPhase::Swing };
-            self.legs[l] = Leg { phase, anchor, contact: anchor, elapsed: 0.0, pep: foot, foot, joints: q };
+            self.walk.legs[l] = Leg { phase, anchor, contact: anchor, elapsed: 0.0, pep: foot, foot, joints: q };
         }
-        self.body = Some(BodyMotion::new(pose));
+        self.walk.body = Some(BodyMotion::new(pose));
     }
 
     /// Rule 1 (Eq. 7.32-7.37): the posture that puts the last contact points of the working
@@ -196,7 +183,7 @@ impl FreeGaitController {
         let to_body = estimated.inverse();
         let (mut p0, mut reference) = (Vec::with_capacity(6), Vec::with_capacity(6));
         for l in (0..6).filter(|&l| self.working(l)) {
-            p0.push(to_body.apply(&self.legs[l].contact));
+            p0.push(to_body.apply(&self.walk.legs[l].contact));
             let kin = &self.legs_kinematics[l];
             reference.push(kin.to_body(&self.workspaces[l].centre_at(-self.options.body_height)).z);
         }
@@ -248,12 +235,12 @@ impl FreeGaitController {
         }
         let mut order: Vec<usize> = (0..6).filter(|&l| candidates[l]).collect();
         order.sort_by(|&a, &b| margins[a].total_cmp(&margins[b]));
-        let mut support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.legs[l].phase == FootPhase::Support);
+        let mut support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
         let centre = estimated.translation.xy();
         let mut lifting = [false; 6];
         for l in order {
             support[l] = false;
-            let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.legs[k].anchor.xy()).collect();
+            let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
             if stability_margin(&centre, &feet) >= self.options.stability_margin {
                 lifting[l] = true;
             } else {
@@ -268,20 +255,20 @@ impl Controller for FreeGaitController {
     fn update(&mut self, m: &Measurements) -> Command {
         let o = self.options.clone();
         let h: Heading = self.heading.heading(m.t);
-        let first = self.body.is_none();
+        let first = self.walk.body.is_none();
         if first {
             self.start(m);
         }
         let contact = self.landing.ground_contact(m);
-        let before = self.body.as_ref().expect("started").pose;
+        let before = self.walk.body.as_ref().expect("started").pose;
         let estimated = estimated_pose(m, &before);
 
         // Landings detected: the support begins where the encoders put the foot (Section 7.4).
         self.state.touchdowns = [false; 6];
         for l in 0..6 {
-            if self.legs[l].phase == FootPhase::Landing && contact[l] {
+            if self.walk.legs[l].phase == FootPhase::Landing && contact[l] {
                 let measured = self.leg_frame(l, &estimated).apply(&self.legs_kinematics[l].foot(&joints_of(m, l)));
-                let leg = &mut self.legs[l];
+                let leg = &mut self.walk.legs[l];
                 (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured, measured, 0.0);
                 self.state.touchdowns[l] = true;
             }
@@ -305,9 +292,9 @@ impl Controller for FreeGaitController {
         };
         if !first {
             // Eq. 7.12-7.23.
-            self.body.as_mut().expect("started").step(v_b, omega_b, o.dt);
+            self.walk.body.as_mut().expect("started").step(v_b, omega_b, o.dt);
         }
-        let body = self.body.clone().expect("started");
+        let body = self.walk.body.clone().expect("started");
         let desired = body.pose.htm();
         let estimated = estimated_pose(m, &body.pose);
 
@@ -316,7 +303,7 @@ impl Controller for FreeGaitController {
         let mut margins = [f64::INFINITY; 6];
         let mut speed_max = 0.0f64;
         for l in 0..6 {
-            let mut leg = self.legs[l];
+            let mut leg = self.walk.legs[l];
             let frame_desired = self.leg_frame(l, &desired);
             let c = self.workspaces[l].centre_at(-o.body_height);
             let v_c = centre_velocity(&self.legs_kinematics[l], &c, &frame_desired, &desired, &h);
@@ -371,14 +358,14 @@ impl Controller for FreeGaitController {
             }
             leg.joints = ik.joints;
             references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
-            self.legs[l] = leg;
+            self.walk.legs[l] = leg;
         }
 
         // Rules 2 and 3, and the deadlock condition (Section 7.7.4).
-        let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.legs[l].phase == FootPhase::Support);
+        let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
         let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours), &margins, &estimated);
         for l in (0..6).filter(|&l| lifting[l]) {
-            let leg = &mut self.legs[l];
+            let leg = &mut self.walk.legs[l];
             (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);
         }
         self.state.deadlock = deadlocked(&support, &margins, &lifting, speed_max * o.dt);
@@ -386,12 +373,28 @@ impl Controller for FreeGaitController {
 
         // The posture as the controller knows it.
         let to_body = estimated.inverse();
-        let contacts: Vec<Vector3<f64>> = (0..6).filter(|&l| self.working(l)).map(|l| to_body.apply(&self.legs[l].contact)).collect();
+        let contacts: Vec<Vector3<f64>> = (0..6).filter(|&l| self.working(l)).map(|l| to_body.apply(&self.walk.legs[l].contact)).collect();
         self.state.clearance = ground_plane(&contacts).map_or(f64::NAN, |(height, _)| height);
         let angles = m.pose.map_or(body.pose.angles, |p| pose_of(&p).angles);
         (self.state.pitch, self.state.roll) = (angles.y, angles.z);
 
         let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
         Command { voltages, references }
+    }
+}
+
+impl LegState for Leg {
+    fn phase(&self) -> FootPhase {
+        self.phase
+    }
+    fn foot(&self) -> Vector3<f64> {
+        self.foot
+    }
+}
+
+impl std::ops::Deref for FreeGaitController {
+    type Target = Walk<Leg>;
+    fn deref(&self) -> &Walk<Leg> {
+        &self.walk
     }
 }
