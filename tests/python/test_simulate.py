@@ -54,6 +54,9 @@ SHIPPED = {
     "free_gait_straight",
     "free_gait_slope_square",
     "free_gait_five_legs",
+    "free_gait_step",
+    "free_gait_rough_spline",
+    "free_gait_rough_spline_no_navigation",
 }
 
 
