@@ -71,6 +71,7 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin link
 	$(CARGO) run --release -p hexadyn-benches --bin terrain
 	$(CARGO) run --release -p hexadyn-benches --bin terrain_classes
+	$(CARGO) run --release -p hexadyn-benches --bin free_gait_cases
 
 # The shipped terrains are generated, never drawn: physics::terrain::generate, written as PLY.
 terrains:

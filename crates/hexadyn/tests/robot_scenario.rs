@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
+use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
 use hexadyn::description::AMRU5_TOML;
 use hexadyn::hexapod::Joint;
 
@@ -384,6 +384,16 @@ fn walking_scenarios_parse() {
     assert!(matches!(s.gait.as_ref().unwrap().heading, HeadingSpec::Square { side: 0.375, speed: 0.015 }));
     assert!(!s.plant.navigation);
 
+    // The free gait's landing: from the motor currents by default (40 N, Section 5.6.3), the
+    // simulated normal force when asked (10 N, Section 7.7).
+    let landing = |text: &str| parse(text).unwrap().gait.unwrap().free.unwrap().landing;
+    assert_eq!(landing(&shipped("free_gait_straight")), LandingSpec::Current { threshold: 40.0 });
+    assert_eq!(landing(&shipped("free_gait_five_legs")), LandingSpec::Force { threshold: 10.0 });
+    assert_eq!(landing(&shipped("free_gait_slope_square")), LandingSpec::Force { threshold: 10.0 });
+    assert_eq!(landing(&with("free_gait_slope_square", "landing_threshold_n = 10.0\n", "")), LandingSpec::Force { threshold: 10.0 });
+    assert_eq!(landing(&with("free_gait_straight", "landing = \"current\"", "landing = \"force\"").replace("landing_threshold_n = 40.0", "")), LandingSpec::Force { threshold: 10.0 });
+    assert_eq!(landing(&with("free_gait_slope_square", "landing = \"force\"\nlanding_threshold_n = 10.0\n", "")), LandingSpec::Current { threshold: 40.0 });
+
     // Waypoints of a spline.
     let text = with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 50.0, 100.0]\nx_m = [0.0, 0.5, 1.0]\ny_m = [0.0, 0.2, 0.0]");
     assert!(matches!(parse(&text).unwrap().gait.unwrap().heading, HeadingSpec::Spline { built_in: false, .. }));
@@ -438,6 +448,11 @@ fn gait_errors_name_the_field() {
     assert!(s.contains("strictly increasing"), "{s}");
     let s = field_error(&with(v, "kind = \"constant\"", "kind = \"csv\"\nfile = \"no_such.csv\"").replace("vx_m_s = 0.015\nvy_m_s = 0.0\nomega_z_rad_s = 0.0\n", ""), "gait.heading.file");
     assert!(s.contains("no_such.csv") && s.contains("cannot read") && s.contains("t,vx,vy,omega_z"), "{s}");
+
+    let s = field_error(&with("free_gait_straight", "landing_threshold_n = 40.0", "landing_threshold_n = -5.0"), "gait.free.landing_threshold_n");
+    assert!(s.contains("-5") && s.contains("landing = \"current\"") && s.contains("40 N"), "{s}");
+    let s = field_error(&with("free_gait_straight", "landing = \"current\"", "landing = \"switch\""), "gait.free.landing");
+    assert!(s.contains("switch") && s.contains("current") && s.contains("force"), "{s}");
 
     let s = field_error(&with("gait_changes", "at_s = 50.0", "at_s = 90.0"), "gait.change[1].at_s");
     assert!(s.contains("90") && s.contains("(20, 80)"), "{s}");

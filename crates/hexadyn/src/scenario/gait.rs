@@ -14,7 +14,7 @@ use nalgebra::Vector3;
 use serde::Deserialize;
 
 use crate::control::gait::controller::{joints_at, steady_footholds, AepMode, GaitController, GaitOptions};
-use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDetector, NormalForce, THESIS_FORCE_THRESHOLD};
+use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDetector, MotorCurrent, NormalForce, THESIS_CURRENT_THRESHOLD, THESIS_FORCE_THRESHOLD};
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
@@ -94,8 +94,11 @@ pub(super) struct RawGait {
 #[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum LandingKind {
-    /// The true normal force above a threshold: the simulation mode of Section 7.7.
+    /// The ground force estimated from the motor currents (Section 5.6.3), as on the real
+    /// robot.
     #[default]
+    Current,
+    /// The true normal force above a threshold: the simulation mode of Section 7.7.
     Force,
 }
 
@@ -198,15 +201,26 @@ impl HeadingSpec {
 /// The landing detection of a free gait scenario.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LandingSpec {
+    /// [`MotorCurrent`]: the ground detection of Section 5.6.3 with its threshold on the
+    /// estimated vertical ground force (N).
+    Current { threshold: f64 },
     /// [`NormalForce`] with its threshold (N).
     Force { threshold: f64 },
 }
 
 impl LandingSpec {
-    /// A fresh detector for a run. The current-based detector of Section 5.6 plugs in here.
-    pub fn detector(&self) -> Box<dyn LandingDetector> {
+    /// A fresh detector for a run of `robot` at the control period `dt` (s).
+    pub fn detector(&self, robot: &RobotDescription, dt: f64) -> Box<dyn LandingDetector> {
         match *self {
+            LandingSpec::Current { threshold } => Box::new(MotorCurrent::new(robot, dt, threshold).expect("the scenario's validation built the legs of this robot")),
             LandingSpec::Force { threshold } => Box::new(NormalForce { threshold }),
+        }
+    }
+
+    /// The threshold (N), on the estimated or on the true normal force.
+    pub fn threshold(&self) -> f64 {
+        match *self {
+            LandingSpec::Current { threshold } | LandingSpec::Force { threshold } => threshold,
         }
     }
 }
@@ -248,7 +262,7 @@ impl GaitScenario {
         let pis = joint_pis(robot, self.options.dt);
         match &self.free {
             Some(free) => {
-                let controller = FreeGaitController::new(free.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector());
+                let controller = FreeGaitController::new(free.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
                 let (c, state) = PublishedFreeGait::new(controller);
                 (Box::new(c), state)
             }
@@ -438,8 +452,12 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [Leg
     let takeoff_time = positive("takeoff_s", raw.takeoff_s, DEFAULT_TAKEOFF_S)?;
     let swing_time = positive("swing_s", raw.swing_s, DEFAULT_SWING_S)?;
     let posture_time = positive("posture_time_s", raw.posture_time_s, DEFAULT_POSTURE_TIME_S)?;
-    let threshold = raw.landing_threshold_n.unwrap_or(THESIS_FORCE_THRESHOLD);
-    c.check(threshold.is_finite() && threshold > 0.0, "gait.free.landing_threshold_n", threshold, "a normal force > 0 N (Section 7.7: 10 N)")?;
+    let (default_threshold, allowed) = match raw.landing {
+        LandingKind::Current => (THESIS_CURRENT_THRESHOLD, "an estimated vertical ground force > 0 N with landing = \"current\" (default 40 N, the lowest threshold of Section 5.6.3)"),
+        LandingKind::Force => (THESIS_FORCE_THRESHOLD, "a normal force > 0 N with landing = \"force\" (Section 7.7: 10 N)"),
+    };
+    let threshold = raw.landing_threshold_n.unwrap_or(default_threshold);
+    c.check(threshold.is_finite() && threshold > 0.0, "gait.free.landing_threshold_n", threshold, allowed)?;
     let failed_leg = match raw.failed_leg {
         None => None,
         Some(l) => {
@@ -463,6 +481,7 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [Leg
     let free_pattern = GaitPattern { name: "free".into(), beta: f64::NAN, offsets: [0.0; 6] };
     let periodic = GaitOptions { period: f64::NAN, pattern: free_pattern, cycle: FootCycle::Plain, aep: AepMode::Omnidirectional, lift, dt };
     let free = FreeGaitSpec { options, landing: match raw.landing {
+        LandingKind::Current => LandingSpec::Current { threshold },
         LandingKind::Force => LandingSpec::Force { threshold },
     } };
     Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs, workspaces, changes: Vec::new(), joints })

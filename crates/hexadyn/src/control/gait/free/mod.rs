@@ -11,7 +11,7 @@ pub mod rules;
 pub mod velocity;
 
 pub use controller::{FreeGaitController, FreeGaitOptions, FreeGaitState};
-pub use landing::{LandingDetector, NormalForce, THESIS_FORCE_THRESHOLD};
+pub use landing::{LandingDetector, MotorCurrent, NormalForce, THESIS_CURRENT_THRESHOLD, THESIS_FORCE_THRESHOLD};
 
 #[cfg(test)]
 mod tests;
