@@ -191,7 +191,7 @@ def _readout(frame: Frame) -> str:
     """The state read-out: a table for people, data attributes for scripts."""
     feet = frame.feet
     rows = "".join(
-        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{frame.forces[leg, 2]:.1f}</td><td>{PHASE_NAMES.get(int(frame.phases[leg]), "")}</td></tr>"
+        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{frame.forces[leg, 2]:.1f}</td><td>{PHASE_NAMES.get(int(frame.phases[leg]), '')}</td></tr>"
         for leg in range(LEGS)
     )
     attributes = f'data-t="{frame.t!r}" data-index="{frame.index}" data-feet="{html.escape(json.dumps(feet.tolist()))}"'
