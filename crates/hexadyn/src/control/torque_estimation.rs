@@ -18,8 +18,8 @@
 use super::interface::Measurements;
 use super::low_pass::DigitalLowPass;
 use crate::description::RobotDescription;
-use crate::hexapod::{Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
-use crate::mbs::{self, Data};
+use crate::hexapod::{joint_torques, Joint, Mechanics, MechanicsParameters, StillBody, JOINTS};
+use crate::mbs::Data;
 use crate::physics::DryViscous;
 
 /// The joint torques of one control instant (Nm for q_r, N for q_v and q_h), per joint
@@ -57,8 +57,6 @@ pub struct TorqueEstimator {
     positions: [DigitalLowPass; JOINTS],
     currents: [DigitalLowPass; JOINTS],
     estimate: Option<TorqueEstimate>,
-    coordinates: [[f64; DOF]; 3],
-    residual: [f64; DOF],
 }
 
 impl TorqueEstimator {
@@ -78,8 +76,6 @@ impl TorqueEstimator {
             positions: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
             currents: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
             estimate: None,
-            coordinates: [[0.0; DOF]; 3],
-            residual: [0.0; DOF],
         }
     }
 
@@ -106,22 +102,13 @@ impl TorqueEstimator {
         self.estimate.as_ref().expect("just set")
     }
 
-    /// τ̂_iner + τ̂_grav added to τ̂_fric into `e.estimated`: the joint rows of the residual
-    /// M q̈ + h − g of Eq. 3.37 with no applied force but gravity and the body at rest.
+    /// τ̂_iner + τ̂_grav added to τ̂_fric into `e.estimated`: Eq. 3.37 on the legs with the
+    /// body at rest ([`joint_torques`]), no foot force.
     fn inertia_and_gravity(&mut self, m: &Measurements, e: &mut TorqueEstimate) {
-        let [q, qd, qdd] = &mut self.coordinates;
-        if let Some(pose) = &m.pose {
-            (q[4], q[5]) = (pose.pitch, pose.roll);
-        }
-        q[6..].copy_from_slice(&e.q);
-        qd[6..].copy_from_slice(&e.qd);
-        qdd[6..].copy_from_slice(&e.qdd);
-        let model = &self.mechanics.model;
-        mbs::relative_kinematics(model, &mut self.data, q, qd);
-        self.data.clear_forces();
-        mbs::residual(model, &mut self.data, qdd, &mut self.residual);
+        let body = m.pose.map_or(StillBody::default(), |p| StillBody { pitch: p.pitch, roll: p.roll });
+        let tau = joint_torques(&self.mechanics, &mut self.data, body, &e.q, &e.qd, &e.qdd, None);
         for k in 0..JOINTS {
-            e.estimated[k] = self.residual[6 + k] + e.friction[k];
+            e.estimated[k] = tau[k] + e.friction[k];
         }
     }
 }

@@ -3,17 +3,54 @@
 //! The friction identification removes τ_grav from the measured motor torques (Section 5.2.1,
 //! Eq. 5.7) and the ground detection estimates both (Section 5.6.2, Fig. 5.12).
 
-use super::{joint_index, Mechanics, DOF, LEG_COUNT};
+use super::{joint_index, Mechanics, DOF, JOINTS, LEG_COUNT};
 use nalgebra::Vector3;
 
 use crate::mbs::{relative_kinematics, residual, Data};
 
-/// The generalized forces (Nm for q_r, N for q_v and q_h) the motors of `leg` must apply for
-/// the leg to follow (q, q', q'') = (`q`, `qd`, `qdd`) with the body at rest and level and the
-/// force `foot_force` (global frame, N) on the foot: the leg's rows of the multibody residual (Eq. 3.37, 3.38) without applied
-/// joint forces. The rotors are part of the leg (their inertia counts in q''). Every leg is put
-/// in the same configuration (a closed pantograph needs a valid one), which does not change
-/// the rows of `leg`: with the body still, a leg's rows see only its own bodies.
+/// The body at rest under the legs of [`joint_torques`]: its pitch and roll (rad, Eq. 3.52),
+/// which set the direction of gravity in the body frame; `StillBody::default()` is level.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StillBody {
+    pub pitch: f64,
+    pub roll: f64,
+}
+
+/// The generalized forces (Nm for q_r, N for q_v and q_h; joint k = 3 leg + j) the motors must
+/// apply for the legs to follow (q, q', q'') = (`q`, `qd`, `qdd`) with the body at rest at the
+/// attitude `body` and the forces `foot_forces` (global frame, N) on the feet: the joint rows
+/// of the multibody residual M q̈ + h − g (Eq. 3.37, 3.38) without applied joint forces, i.e.
+/// τ_grav + τ_iner of Eq. 5.14. The rotors are part of the legs (their inertia counts in q'').
+pub fn joint_torques(
+    mech: &Mechanics,
+    data: &mut Data,
+    body: StillBody,
+    q: &[f64; JOINTS],
+    qd: &[f64; JOINTS],
+    qdd: &[f64; JOINTS],
+    foot_forces: Option<&[Vector3<f64>; LEG_COUNT]>,
+) -> [f64; JOINTS] {
+    let (mut x, mut xd, mut xdd) = ([0.0; DOF], [0.0; DOF], [0.0; DOF]);
+    (x[4], x[5]) = (body.pitch, body.roll);
+    x[joint_index(0, 0)..].copy_from_slice(q);
+    xd[joint_index(0, 0)..].copy_from_slice(qd);
+    xdd[joint_index(0, 0)..].copy_from_slice(qdd);
+    relative_kinematics(&mech.model, data, &x, &xd);
+    data.clear_forces();
+    for (leg, force) in foot_forces.into_iter().flatten().enumerate() {
+        let foot = mech.legs[leg].links[3];
+        let p = data.point(foot, &mech.foot_local);
+        data.add_force(foot, &p, force);
+    }
+    let mut f = [0.0; DOF];
+    residual(&mech.model, data, &xdd, &mut f);
+    std::array::from_fn(|k| f[joint_index(0, 0) + k])
+}
+
+/// [`joint_torques`] of one `leg` on a still, level body, the force `foot_force` (global frame,
+/// N) on its foot. Every leg is put in the same configuration (a closed pantograph needs a
+/// valid one), which does not change the rows of `leg`: with the body still, a leg's rows see
+/// only its own bodies.
 pub fn leg_joint_torques(
     mech: &Mechanics,
     data: &mut Data,
@@ -24,24 +61,12 @@ pub fn leg_joint_torques(
     foot_force: Vector3<f64>,
 ) -> [f64; 3] {
     assert!(leg < LEG_COUNT, "leg {leg} of a hexapod");
-    let (mut x, mut xd, mut xdd) = ([0.0; DOF], [0.0; DOF], [0.0; DOF]);
-    for l in 0..LEG_COUNT {
-        for j in 0..3 {
-            x[joint_index(l, j)] = q[j];
-        }
-    }
-    for j in 0..3 {
-        xd[joint_index(leg, j)] = qd[j];
-        xdd[joint_index(leg, j)] = qdd[j];
-    }
-    relative_kinematics(&mech.model, data, &x, &xd);
-    data.clear_forces();
-    let foot = mech.legs[leg].links[3];
-    let p = data.point(foot, &mech.foot_local);
-    data.add_force(foot, &p, &foot_force);
-    let mut f = [0.0; DOF];
-    residual(&mech.model, data, &xdd, &mut f);
-    std::array::from_fn(|j| f[joint_index(leg, j)])
+    let every_leg_at_q: [f64; JOINTS] = std::array::from_fn(|k| q[k % 3]);
+    let only_leg = |v: [f64; 3]| -> [f64; JOINTS] { std::array::from_fn(|k| if k / 3 == leg { v[k % 3] } else { 0.0 }) };
+    let mut forces = [Vector3::zeros(); LEG_COUNT];
+    forces[leg] = foot_force;
+    let tau = joint_torques(mech, data, StillBody::default(), &every_leg_at_q, &only_leg(qd), &only_leg(qdd), Some(&forces));
+    std::array::from_fn(|j| tau[3 * leg + j])
 }
 
 #[cfg(test)]

@@ -18,7 +18,7 @@ pub mod mechanics;
 pub mod pantograph;
 pub mod workspace;
 
-pub use leg_dynamics::leg_joint_torques;
+pub use leg_dynamics::{joint_torques, leg_joint_torques, StillBody};
 pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegKinematics, LegKinematicsError, Limit};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::PantographGeometry;
