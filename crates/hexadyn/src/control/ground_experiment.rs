@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use super::ground_detection::{GroundDetector, LegDetection};
 use super::interface::{Command, Controller, Measurements};
-use super::DigitalPi;
+use super::{pi_command, DigitalPi};
 use crate::hexapod::{JOINTS, LEG_COUNT};
 
 /// Rest after each tested leg is put back on the ground (s).
@@ -204,8 +204,7 @@ impl Controller for GroundExperimentController {
         }
         st.holding = self.hold.is_some();
         st.detections = detections;
-        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
-        Command { voltages, references }
+        pi_command(&mut self.pis, references, m)
     }
 }
 

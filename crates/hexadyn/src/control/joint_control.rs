@@ -16,6 +16,13 @@ pub fn joint_pis(robot: &RobotDescription, dt: f64) -> [DigitalPi; JOINTS] {
     })
 }
 
+/// The command of the 18 digital PI position loops (Eq. 4.18-4.20, antiwindup at the supply
+/// voltage, Section 4.4.5) tracking `references`: the last stage of every closed-loop controller.
+pub fn pi_command(pis: &mut [DigitalPi; JOINTS], references: [f64; JOINTS], m: &Measurements) -> Command {
+    let voltages = std::array::from_fn(|k| pis[k].update(references[k] - m.positions[k], m.supply_voltage));
+    Command { voltages, references }
+}
+
 /// Joint references q_d(t).
 pub trait ReferenceSource {
     fn reference(&mut self, t: f64) -> [f64; JOINTS];

@@ -12,7 +12,7 @@ use super::body_motion::{BodyMotion, Pose};
 use super::walk::{LegState, Walk};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
-use crate::control::{BodyPose, Command, Controller, DigitalPi, Measurements};
+use crate::control::{pi_command, BodyPose, Command, Controller, DigitalPi, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -378,8 +378,7 @@ impl Controller for GaitController {
             self.walk.legs[l] = next;
             references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
         }
-        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
-        Command { voltages, references }
+        pi_command(&mut self.pis, references, m)
     }
 }
 

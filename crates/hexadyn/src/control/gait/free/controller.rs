@@ -21,7 +21,7 @@ use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
-use crate::control::{Command, Controller, DigitalPi, Measurements};
+use crate::control::{pi_command, Command, Controller, DigitalPi, Measurements};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -378,8 +378,7 @@ impl Controller for FreeGaitController {
         let angles = m.pose.map_or(body.pose.angles, |p| pose_of(&p).angles);
         (self.state.pitch, self.state.roll) = (angles.y, angles.z);
 
-        let voltages = std::array::from_fn(|k| self.pis[k].update(references[k] - m.positions[k], m.supply_voltage));
-        Command { voltages, references }
+        pi_command(&mut self.pis, references, m)
     }
 }
 
