@@ -363,7 +363,9 @@ impl Controller for FreeGaitController {
 
         // Rules 2 and 3, and the deadlock condition (Section 7.7.4).
         let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
-        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours), &margins, &estimated);
+        // A neighbour's step: takeoff, swing and a landing as long as the takeoff on flat ground.
+        let reserve = speed_max * (2.0 * o.takeoff_time + o.swing_time);
+        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours, reserve), &margins, &estimated);
         for l in (0..6).filter(|&l| lifting[l]) {
             let leg = &mut self.walk.legs[l];
             (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);

@@ -58,34 +58,28 @@ fn controller(s: &Setup, options: FreeGaitOptions, heading: Heading) -> FreeGait
 }
 
 /// Section 7.7.3: "The combination of these two criteria converges to a tripod gait on flat
-/// ground in most of the cases, and sometimes to a forward wave gait." From 1000 random
-/// postures (every foot uniformly in its workspace disc on the ground) and random walking
-/// directions at 1 cm/s, (a) every start settles within its first 10 steps (a step: the legs
-/// that lift together) into a periodic gait in which every leg lifts equally often, with no
-/// deadlock that does not clear, and (b) most of them (the thesis' "most of the cases") into the alternating tripods
+/// ground in most of the cases", and [PORT04] "proves that tripod convergence is reached with
+/// rule 2 and some priority assignments on neighboring legs". From 1000 random postures (every
+/// foot uniformly in its workspace disc on the ground) and random walking directions at 1 cm/s,
+/// (a) every start settles within its first 10 steps (a step: the legs that lift together) into
+/// a periodic gait in which every leg lifts equally often, with no deadlock that does not clear,
+/// and (b) at least 95 % of them (the issue's criterion) into the alternating tripods
 /// {0, 3, 4}, {1, 2, 5} (NOTES.md numbering), strictly: the steps alternate between exactly
 /// these two sets of three legs to the end of the run.
 ///
-/// NOT MET: the issue's target of 95 % tripods. Measured 56.5 %; the rest settle into the
-/// wave of the circuit's opposite pairs {0, 5}, {2, 3}, {1, 4} or into staggered tripods (two
-/// legs of a tripod at a time). The staggered tripods come from Rule 3 read literally: a
-/// neighbour with a lower margin that cannot swing (its other neighbour is in the air) holds a
-/// leg back. Comparing only with the neighbours that satisfy Rule 2 (a priority by margin, as
-/// [PORT04]'s) gave 86.7 % here but, on the full dynamic model, deadlocked the straight walk
-/// 157 s of 200 s and the five-leg walk for good (a leg lifts before its lower-margin
-/// neighbour, which then reaches its boundary while it is in the air), so it is not used. The
-/// wave is a fixed point of any priority by margin on the two-neighbour circuit of Fig. 7.27:
-/// when a pair lands, the four legs in support form two neighbour pairs, each made of a leg of
-/// the pair that landed before (lower margin) and one of the pair that landed last, and the
-/// former lifts, which repeats the wave; only a different neighbour table (the middle legs 2
-/// and 3 neighbours: 100 % tripods on a kinematic model of the rules) removes it, and the
-/// thesis gives two neighbours per leg. The thesis itself: "sometimes to a forward wave gait".
+/// Measured: 1000/1000 tripods with the priority of [`super::rules::swing_candidates`]. By the
+/// margins alone the rules settle into the tripod from 56.5 % of the starts (Rule 3 literally;
+/// the rest settle into the wave of the circuit's opposite pairs {0, 5}, {2, 3}, {1, 4} or into
+/// staggered tripods, two legs of a tripod at a time) and from 86.7 % with the priority among
+/// the legs that satisfy Rule 2 (the rest: the wave, a fixed point of any priority by margin on
+/// the two-neighbour circuit of Fig. 7.27).
 #[test]
-fn rules_2_and_3_settle_into_a_periodic_gait_mostly_a_tripod() {
+fn rules_2_and_3_settle_into_a_tripod_from_95_percent_of_random_starts() {
     let s = setup();
     let dt = 0.05;
     let mut r = rng(11);
     let (cases, mut tripod, mut periodic) = (1000, 0, 0);
+    let mut longest_deadlock = 0.0f64;
     let tripods = [[true, false, false, true, true, false], [false, true, true, false, false, true]];
     for _ in 0..cases {
         let feet: [Vector3<f64>; 6] = std::array::from_fn(|l| {
@@ -98,7 +92,10 @@ fn rules_2_and_3_settle_into_a_periodic_gait_mostly_a_tripod() {
         let mut c = controller(&s, options(&s, dt, None), heading);
         let mut steps: Vec<[bool; 6]> = Vec::new();
         let mut previous = [FootPhase::Support; 6];
+        let mut deadlock = 0.0;
         run(&mut c, joints_at(&s.legs, &feet).unwrap(), &s, dt, 400.0, |c, _| {
+            deadlock = if c.state().deadlock { deadlock + dt } else { 0.0 };
+            longest_deadlock = longest_deadlock.max(deadlock);
             let phases = c.phases();
             let lifted: [bool; 6] = std::array::from_fn(|l| phases[l] == FootPhase::Takeoff && previous[l] != FootPhase::Takeoff);
             if lifted.iter().any(|&x| x) {
@@ -124,9 +121,9 @@ fn rules_2_and_3_settle_into_a_periodic_gait_mostly_a_tripod() {
             println!("not periodic: direction {direction:.2}: {names:?}");
         }
     }
-    println!("Rules 2-3: {tripod}/{cases} random starts settle into a tripod within 10 steps, {periodic}/{cases} into a periodic gait");
+    println!("Rules 2-3: {tripod}/{cases} random starts settle into a tripod within 10 steps, {periodic}/{cases} into a periodic gait; longest deadlock {longest_deadlock:.2} s");
     assert_eq!(periodic, cases);
-    assert!(2 * tripod > cases, "{tripod}");
+    assert!(100 * tripod >= 95 * cases, "{tripod}/{cases} tripods");
 }
 
 /// Section 7.7.4, a constructed deadlock: leg 1 lifts first (lowest margin); leg 0, its
