@@ -72,10 +72,12 @@ pub fn swing_candidates(support: &[bool; 6], margin: &[f64; 6], neighbours: &[Op
     let of = |l: usize| neighbours[l].map_or([l, l], |(a, b)| [a, b]);
     // Rule 2.
     let rule_2: [bool; 6] = std::array::from_fn(|l| neighbours[l].is_some() && support[l] && margin[l].is_finite() && of(l).iter().all(|&n| support[n]));
-    let before = |a: usize, b: usize| margin[a].total_cmp(&margin[b]).then(a.cmp(&b)).is_lt();
+    // The priority: the lower margin, then the lower leg number.
+    let order = |a: &usize, b: &usize| margin[*a].total_cmp(&margin[*b]).then(a.cmp(b));
+    let before = |a: usize, b: usize| order(&a, &b).is_lt();
     // The legs Rule 2 allows that do not pass a lower-margin neighbour it holds back.
     let mut free: Vec<usize> = (0..6).filter(|&l| rule_2[l] && !of(l).iter().any(|&n| support[n] && !rule_2[n] && before(n, l))).collect();
-    free.sort_by(|&a, &b| margin[a].total_cmp(&margin[b]).then(a.cmp(&b)));
+    free.sort_by(order);
     if neighbours.iter().any(Option::is_none) {
         // A failed leg: Rule 3 as stated (the legs lower than both neighbours).
         return std::array::from_fn(|l| free.contains(&l) && of(l).iter().all(|&n| before(l, n)));
