@@ -123,13 +123,13 @@ fn free_gait_walks_straight_on_flat_ground() {
 }
 
 /// Section 7.7.5, case 2 on the shipped 20° slope: the square of 100 s lines at 1 cm/s. The
-/// pitch settles at 20 ± 1° (the body parallel to the slope). The true clearance, the distance
-/// of the body centre from the slope plane, stays within 5 mm of its start while the robot
-/// crosses the slope (the Y lines); climbing and descending (the X lines) the discrete posture
-/// correction lets it drift between touchdowns (the thesis: "the velocity of the robot is never
-/// parallel to the slope because of the discrete nature of the correction"), by ±3.6 mm/s: its
-/// 10 s means stay within 15 mm of the start (the issue's 5 mm is not met there: measured
-/// 12.5 mm). No fall; the XY error is reported.
+/// pitch settles at 20 ± 1° (the body parallel to the slope) and the true clearance, the
+/// distance of the body centre from the slope plane, stays within 5 mm of its start for the
+/// whole walk after the first 20 s, climbing and descending (the X lines) as well as crossing
+/// the slope (the Y lines): the heading moves the body in its own plane, which the posture
+/// keeps parallel to the slope (Section 7.7.2, [`hexadyn::control::gait::free::velocity`]).
+/// With the heading kept horizontal the clearance drifted by ±3.4 mm/s between touchdowns
+/// climbing and descending (10 s means 12.5 mm off). No fall; the XY error is reported.
 #[test]
 fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     let s = scenario("free_gait_slope_square");
@@ -148,12 +148,14 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     let worst_mean = means.iter().map(|m| (m - clearance[0]).abs()).fold(0.0, f64::max);
     // Crossing the slope: the Y lines, 100-200 s and 300-400 s, 20 s after each turn.
     let crossing = t.iter().zip(&clearance).filter(|(t, _)| (120.0..200.0).contains(*t) || (320.0..400.0).contains(*t)).map(|(_, c)| (c - clearance[0]).abs()).fold(0.0, f64::max);
+    let worst = clearance[after..].iter().map(|c| (c - clearance[0]).abs()).fold(0.0, f64::max);
     let (lo, hi) = clearance[after..].iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
     let g = r.summary.gait.as_ref().unwrap();
     println!(
-        "free gait, 20° slope square: pitch within {:.3}° of 20° after 20 s; clearance {:.4} m at the start, within {:.2} mm of it crossing the slope, 10 s means within {:.2} mm of it, range [{:.4}, {:.4}] m; XY error at the end {:.2} mm, max {:.2} mm",
+        "free gait, 20° slope square: pitch within {:.3}° of 20° after 20 s; clearance {:.4} m at the start, within {:.2} mm of it after 20 s, {:.2} mm crossing the slope, 10 s means within {:.2} mm of it, range [{:.4}, {:.4}] m; XY error at the end {:.2} mm, max {:.2} mm",
         worst_pitch.to_degrees(),
         clearance[0],
+        1e3 * worst,
         1e3 * crossing,
         1e3 * worst_mean,
         lo,
@@ -162,8 +164,7 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
         1e3 * g.tracking_error_xy_max_m
     );
     assert!(worst_pitch < 1f64.to_radians(), "pitch off 20° by {:.2}°", worst_pitch.to_degrees());
-    assert!(crossing < 0.005, "clearance off by {crossing} m crossing the slope");
-    assert!(worst_mean < 0.015, "clearance mean off by {worst_mean} m");
+    assert!(worst < 0.005, "clearance off by {worst} m");
     // The body climbed: without the posture control it could not follow the slope 0.36 m up.
     assert!(z.iter().cloned().fold(0.0, f64::max) > z[0] + 0.3);
 }
