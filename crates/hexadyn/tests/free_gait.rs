@@ -17,12 +17,19 @@ fn scenarios() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios")
 }
 
-/// The first `duration` seconds of a shipped scenario.
-fn prefix(name: &str, duration: f64) -> Scenario {
+/// A shipped scenario with its text edited.
+fn edited(name: &str, edit: impl FnOnce(&str) -> String) -> Scenario {
     let path = scenarios().join(format!("{name}.toml"));
     let text = std::fs::read_to_string(&path).unwrap();
-    let at = text.lines().find(|l| l.starts_with("duration_s")).expect("a duration");
-    Scenario::from_str(&text.replacen(at, &format!("duration_s = {duration:.1}"), 1), &path.display().to_string(), &scenarios()).unwrap_or_else(|e| panic!("{e}"))
+    Scenario::from_str(&edit(&text), &path.display().to_string(), &scenarios()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The first `duration` seconds of a shipped scenario.
+fn prefix(name: &str, duration: f64) -> Scenario {
+    edited(name, |text| {
+        let at = text.lines().find(|l| l.starts_with("duration_s")).expect("a duration");
+        text.replacen(at, &format!("duration_s = {duration:.1}"), 1)
+    })
 }
 
 /// Simulated time of case 3 in the suite (s): a 1000 s run takes about 130 s.
@@ -169,20 +176,68 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     assert!(z.iter().cloned().fold(0.0, f64::max) > z[0] + 0.3);
 }
 
-/// Beyond the thesis: five legs (leg 3 failed, held up) walk 200 s at 0.5 cm/s without falling
-/// and cover most of the 1 m; the failed foot never touches the ground.
+/// Beyond the thesis: five legs, leg `failed` held up (the shipped scenario has leg 3), walk
+/// 200 s at 0.5 cm/s on flat ground with the landings detected from the motor currents: no
+/// fall (the body within 10° of level), every landing detected and none in the air, no deadlock at the end, most of the 1 m
+/// covered; the failed foot never touches the ground.
+fn assert_five_legs_walk(failed: usize) {
+    let s = edited("free_gait_five_legs", |text| text.replacen("failed_leg = 3", &format!("failed_leg = {failed}"), 1));
+    let what = format!("five legs, leg {failed} failed");
+    let r = run_scenario(&s, |_| {}).unwrap();
+    // The body leans towards the corner without a foot between touchdowns: up to 5.2° with a
+    // rear leg failed.
+    let feet = assert_no_fall_within(&r.series, 0.0, 10f64.to_radians(), &what);
+    let l = landings(&r.series, &what);
+    let (longest, stuck) = deadlocks(&r.series);
+    let g = r.summary.gait.as_ref().unwrap();
+    println!("free gait on five legs, leg {failed} failed, 200 s at 0.5 cm/s: walked {:.3} m, XY error at the end {:.2} mm, at least {feet} feet down; {}; longest deadlock {longest:.2} s", g.distance_walked_m, 1e3 * g.tracking_error_xy_final_m, l.report());
+    assert!(column(&r.series, &format!("Fn[{failed}]")).iter().all(|&f| f == 0.0), "{what}: the failed foot touched the ground");
+    assert!(column(&r.series, &format!("phase[{failed}]")).iter().all(|&p| p == 4.0));
+    assert!(!stuck, "{what}: deadlocked at the end");
+    assert!(l.forces.len() + 5 >= l.count && l.count >= 40, "{what}: {}", l.report());
+    assert!(g.distance_walked_m > 0.9, "{what}: walked {} m", g.distance_walked_m);
+}
+
 #[test]
 fn free_gait_walks_on_five_legs() {
-    let s = scenario("free_gait_five_legs");
-    let r = run_scenario(&s, |_| {}).unwrap();
-    let feet = assert_no_fall(&r.series, 0.0, "five legs");
-    let l = landings(&r.series, "five legs");
-    let (longest, _) = deadlocks(&r.series);
-    let g = r.summary.gait.as_ref().unwrap();
-    println!("free gait on five legs, 200 s at 0.5 cm/s: walked {:.3} m, XY error at the end {:.2} mm, at least {feet} feet down; {}; longest deadlock {longest:.2} s", g.distance_walked_m, 1e3 * g.tracking_error_xy_final_m, l.report());
-    assert!(column(&r.series, "Fn[3]").iter().all(|&f| f == 0.0), "the failed foot touched the ground");
-    assert!(column(&r.series, "phase[3]").iter().all(|&p| p == 4.0));
-    assert!(g.distance_walked_m > 0.9, "{}", g.distance_walked_m);
+    assert_five_legs_walk(3);
+}
+
+#[test]
+fn free_gait_walks_on_five_legs_leg_2_failed() {
+    assert_five_legs_walk(2);
+}
+
+// NOT MET on the full dynamic model with leg 0, 1, 4 or 5 failed (all six walk the whole 1.5 m
+// on the ideal plant, `control::gait::free::tests`). Measured: with leg 0, 1 or 5 failed the
+// walk halts for good after 0.28-0.31 m (a support leg at its boundary whose lift would leave
+// the body centre less than 2 cm inside the other feet; the other legs keep stepping in place,
+// 68-72 landings, all detected); with leg 4 failed the body leans towards the rear left corner
+// without a foot (5.2°) until the held-up foot touches the ground. Likely remedies, not done: a
+// body shift towards the remaining support polygon during such a deadlock instead of halting,
+// and holding a failed rear leg higher.
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_0_failed() {
+    assert_five_legs_walk(0);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_1_failed() {
+    assert_five_legs_walk(1);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_4_failed() {
+    assert_five_legs_walk(4);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_5_failed() {
+    assert_five_legs_walk(5);
 }
 
 /// The deadlock periods of a run (Section 7.7.4): the longest one (s) and whether the run ends
