@@ -17,12 +17,19 @@ fn scenarios() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios")
 }
 
-/// The first `duration` seconds of a shipped scenario.
-fn prefix(name: &str, duration: f64) -> Scenario {
+/// A shipped scenario with its text edited.
+fn edited(name: &str, edit: impl FnOnce(&str) -> String) -> Scenario {
     let path = scenarios().join(format!("{name}.toml"));
     let text = std::fs::read_to_string(&path).unwrap();
-    let at = text.lines().find(|l| l.starts_with("duration_s")).expect("a duration");
-    Scenario::from_str(&text.replacen(at, &format!("duration_s = {duration:.1}"), 1), &path.display().to_string(), &scenarios()).unwrap_or_else(|e| panic!("{e}"))
+    Scenario::from_str(&edit(&text), &path.display().to_string(), &scenarios()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The first `duration` seconds of a shipped scenario.
+fn prefix(name: &str, duration: f64) -> Scenario {
+    edited(name, |text| {
+        let at = text.lines().find(|l| l.starts_with("duration_s")).expect("a duration");
+        text.replacen(at, &format!("duration_s = {duration:.1}"), 1)
+    })
 }
 
 /// Simulated time of case 3 in the suite (s): a 1000 s run takes about 130 s.
@@ -123,13 +130,13 @@ fn free_gait_walks_straight_on_flat_ground() {
 }
 
 /// Section 7.7.5, case 2 on the shipped 20° slope: the square of 100 s lines at 1 cm/s. The
-/// pitch settles at 20 ± 1° (the body parallel to the slope). The true clearance, the distance
-/// of the body centre from the slope plane, stays within 5 mm of its start while the robot
-/// crosses the slope (the Y lines); climbing and descending (the X lines) the discrete posture
-/// correction lets it drift between touchdowns (the thesis: "the velocity of the robot is never
-/// parallel to the slope because of the discrete nature of the correction"), by ±3.6 mm/s: its
-/// 10 s means stay within 15 mm of the start (the issue's 5 mm is not met there: measured
-/// 12.5 mm). No fall; the XY error is reported.
+/// pitch settles at 20 ± 1° (the body parallel to the slope) and the true clearance, the
+/// distance of the body centre from the slope plane, stays within 5 mm of its start for the
+/// whole walk after the first 20 s, climbing and descending (the X lines) as well as crossing
+/// the slope (the Y lines): the heading moves the body in its own plane, which the posture
+/// keeps parallel to the slope (Section 7.7.2, [`hexadyn::control::gait::free::velocity`]).
+/// With the heading kept horizontal the clearance drifted by ±3.4 mm/s between touchdowns
+/// climbing and descending (10 s means 12.5 mm off). No fall; the XY error is reported.
 #[test]
 fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     let s = scenario("free_gait_slope_square");
@@ -148,12 +155,14 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     let worst_mean = means.iter().map(|m| (m - clearance[0]).abs()).fold(0.0, f64::max);
     // Crossing the slope: the Y lines, 100-200 s and 300-400 s, 20 s after each turn.
     let crossing = t.iter().zip(&clearance).filter(|(t, _)| (120.0..200.0).contains(*t) || (320.0..400.0).contains(*t)).map(|(_, c)| (c - clearance[0]).abs()).fold(0.0, f64::max);
+    let worst = clearance[after..].iter().map(|c| (c - clearance[0]).abs()).fold(0.0, f64::max);
     let (lo, hi) = clearance[after..].iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
     let g = r.summary.gait.as_ref().unwrap();
     println!(
-        "free gait, 20° slope square: pitch within {:.3}° of 20° after 20 s; clearance {:.4} m at the start, within {:.2} mm of it crossing the slope, 10 s means within {:.2} mm of it, range [{:.4}, {:.4}] m; XY error at the end {:.2} mm, max {:.2} mm",
+        "free gait, 20° slope square: pitch within {:.3}° of 20° after 20 s; clearance {:.4} m at the start, within {:.2} mm of it after 20 s, {:.2} mm crossing the slope, 10 s means within {:.2} mm of it, range [{:.4}, {:.4}] m; XY error at the end {:.2} mm, max {:.2} mm",
         worst_pitch.to_degrees(),
         clearance[0],
+        1e3 * worst,
         1e3 * crossing,
         1e3 * worst_mean,
         lo,
@@ -162,26 +171,73 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
         1e3 * g.tracking_error_xy_max_m
     );
     assert!(worst_pitch < 1f64.to_radians(), "pitch off 20° by {:.2}°", worst_pitch.to_degrees());
-    assert!(crossing < 0.005, "clearance off by {crossing} m crossing the slope");
-    assert!(worst_mean < 0.015, "clearance mean off by {worst_mean} m");
+    assert!(worst < 0.005, "clearance off by {worst} m");
     // The body climbed: without the posture control it could not follow the slope 0.36 m up.
     assert!(z.iter().cloned().fold(0.0, f64::max) > z[0] + 0.3);
 }
 
-/// Beyond the thesis: five legs (leg 3 failed, held up) walk 200 s at 0.5 cm/s without falling
-/// and cover most of the 1 m; the failed foot never touches the ground.
+/// Beyond the thesis: five legs, leg `failed` held up (the shipped scenario has leg 3), walk
+/// 200 s at 0.5 cm/s on flat ground with the landings detected from the motor currents: no
+/// fall (the body within 10° of level), every landing detected and none in the air, no deadlock at the end, most of the 1 m
+/// covered; the failed foot never touches the ground.
+fn assert_five_legs_walk(failed: usize) {
+    let s = edited("free_gait_five_legs", |text| text.replacen("failed_leg = 3", &format!("failed_leg = {failed}"), 1));
+    let what = format!("five legs, leg {failed} failed");
+    let r = run_scenario(&s, |_| {}).unwrap();
+    // The body leans towards the corner without a foot between touchdowns: up to 5.2° with a
+    // rear leg failed.
+    let feet = assert_no_fall_within(&r.series, 0.0, 10f64.to_radians(), &what);
+    let l = landings(&r.series, &what);
+    let (longest, stuck) = deadlocks(&r.series);
+    let g = r.summary.gait.as_ref().unwrap();
+    println!("free gait on five legs, leg {failed} failed, 200 s at 0.5 cm/s: walked {:.3} m, XY error at the end {:.2} mm, at least {feet} feet down; {}; longest deadlock {longest:.2} s", g.distance_walked_m, 1e3 * g.tracking_error_xy_final_m, l.report());
+    assert!(column(&r.series, &format!("Fn[{failed}]")).iter().all(|&f| f == 0.0), "{what}: the failed foot touched the ground");
+    assert!(column(&r.series, &format!("phase[{failed}]")).iter().all(|&p| p == 4.0));
+    assert!(!stuck, "{what}: deadlocked at the end");
+    assert!(l.forces.len() + 5 >= l.count && l.count >= 40, "{what}: {}", l.report());
+    assert!(g.distance_walked_m > 0.9, "{what}: walked {} m", g.distance_walked_m);
+}
+
 #[test]
 fn free_gait_walks_on_five_legs() {
-    let s = scenario("free_gait_five_legs");
-    let r = run_scenario(&s, |_| {}).unwrap();
-    let feet = assert_no_fall(&r.series, 0.0, "five legs");
-    let l = landings(&r.series, "five legs");
-    let (longest, _) = deadlocks(&r.series);
-    let g = r.summary.gait.as_ref().unwrap();
-    println!("free gait on five legs, 200 s at 0.5 cm/s: walked {:.3} m, XY error at the end {:.2} mm, at least {feet} feet down; {}; longest deadlock {longest:.2} s", g.distance_walked_m, 1e3 * g.tracking_error_xy_final_m, l.report());
-    assert!(column(&r.series, "Fn[3]").iter().all(|&f| f == 0.0), "the failed foot touched the ground");
-    assert!(column(&r.series, "phase[3]").iter().all(|&p| p == 4.0));
-    assert!(g.distance_walked_m > 0.9, "{}", g.distance_walked_m);
+    assert_five_legs_walk(3);
+}
+
+#[test]
+fn free_gait_walks_on_five_legs_leg_2_failed() {
+    assert_five_legs_walk(2);
+}
+
+// NOT MET on the full dynamic model with leg 0, 1, 4 or 5 failed (all six walk the whole 1.5 m
+// on the ideal plant, `control::gait::free::tests`). Measured: with leg 0, 1 or 5 failed the
+// walk halts for good after 0.28-0.31 m (a support leg at its boundary whose lift would leave
+// the body centre less than 2 cm inside the other feet; the other legs keep stepping in place,
+// 68-72 landings, all detected); with leg 4 failed the body leans towards the rear left corner
+// without a foot (5.2°) until the held-up foot touches the ground. Likely remedies, not done: a
+// body shift towards the remaining support polygon during such a deadlock instead of halting,
+// and holding a failed rear leg higher.
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_0_failed() {
+    assert_five_legs_walk(0);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_1_failed() {
+    assert_five_legs_walk(1);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_4_failed() {
+    assert_five_legs_walk(4);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_on_five_legs_leg_5_failed() {
+    assert_five_legs_walk(5);
 }
 
 /// The deadlock periods of a run (Section 7.7.4): the longest one (s) and whether the run ends

@@ -388,7 +388,7 @@ fn walking_scenarios_parse() {
     // simulated normal force when asked (10 N, Section 7.7).
     let landing = |text: &str| parse(text).unwrap().gait.unwrap().free.unwrap().landing;
     assert_eq!(landing(&shipped("free_gait_straight")), LandingSpec::Current { threshold: 40.0 });
-    assert_eq!(landing(&shipped("free_gait_five_legs")), LandingSpec::Force { threshold: 10.0 });
+    assert_eq!(landing(&shipped("free_gait_five_legs")), LandingSpec::Current { threshold: 40.0 });
     assert_eq!(landing(&shipped("free_gait_slope_square")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_slope_square", "landing_threshold_n = 10.0\n", "")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_straight", "landing = \"current\"", "landing = \"force\"").replace("landing_threshold_n = 40.0", "")), LandingSpec::Force { threshold: 10.0 });

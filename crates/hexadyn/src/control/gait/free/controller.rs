@@ -106,6 +106,8 @@ pub struct FreeGaitController {
     heading: Box<dyn HeadingSource>,
     landing: Box<dyn LandingDetector>,
     neighbours: [Option<(usize, usize)>; 6],
+    /// Offset of each leg's footholds from its workspace centre (leg frame): zero on six legs.
+    foothold_offset: [Vector3<f64>; 6],
     walk: Walk<Leg>,
     /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
     posture: (Vector3<f64>, f64),
@@ -125,6 +127,7 @@ impl FreeGaitController {
         let z = Vector3::zeros();
         let idle = Leg { phase: FootPhase::Support, anchor: z, contact: z, elapsed: 0.0, pep: z, foot: z, joints: z };
         let neighbours = neighbours(options.failed_leg);
+        let foothold_offset = foothold_offsets(&options, &legs, &workspaces);
         FreeGaitController {
             options,
             legs_kinematics: legs,
@@ -133,6 +136,7 @@ impl FreeGaitController {
             heading,
             landing,
             neighbours,
+            foothold_offset,
             walk: Walk { body: None, legs: [idle; 6] },
             posture: (z, f64::NEG_INFINITY),
             state: FreeGaitState::default(),
@@ -206,9 +210,14 @@ impl FreeGaitController {
         let w = &self.workspaces[leg];
         let v = Vector3::new(v_c.x, v_c.y, 0.0);
         let speed = v.norm();
-        let mut aep = w.centre_at(z);
+        let offset = self.foothold_offset[leg];
+        let mut aep = w.centre_at(z) + offset;
         if speed > 0.0 {
-            aep += v * ((w.radius - speed * self.options.takeoff_time - AEP_SECURITY).max(0.0) / speed);
+            // The boundary along v̂ from the (offset) centre: |o + s v̂| = R.
+            let u = v / speed;
+            let ou = offset.dot(&u);
+            let reach = -ou + (ou * ou + w.radius * w.radius - offset.norm_squared()).max(0.0).sqrt();
+            aep += u * (reach - speed * self.options.takeoff_time - AEP_SECURITY).max(0.0);
         }
         aep
     }
@@ -228,14 +237,37 @@ impl FreeGaitController {
 
     /// The legs that lift now among the Rule 2-3 candidates: all of them with six legs; with a
     /// failed leg, in order of increasing margin, those whose lift leaves the body centre inside
-    /// the support polygon by at least the stability margin.
-    fn lifting(&self, candidates: [bool; 6], margins: &[f64; 6], estimated: &Htm) -> [bool; 6] {
+    /// the support polygon by at least the stability margin. If that leaves the robot deadlocked
+    /// (Section 7.7.4: a support leg at its boundary, `boundary`, that does not lift), the leg of
+    /// lowest margin among those that Rule 2 alone allows and that keep the stability margin
+    /// lifts instead.
+    ///
+    /// INTERPRETATION (beyond the thesis): on five legs Rule 3's candidate can be a leg whose
+    /// lift would tip the robot; at the start, with the feet at their workspace centres and equal
+    /// margins, the tie-break makes it the only candidate, and the robot would stay halted for
+    /// good (legs 0, 1 and 2 failed). Lifting another leg that Rule 2 allows is the smallest
+    /// change that lets the walk go on: Rule 3 orders the legs, the stability decides.
+    fn lifting(&self, candidates: [bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
         if self.options.failed_leg.is_none() {
             return candidates;
         }
+        let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
+        let lifting = self.stable_lifts(candidates, margins, &support, estimated);
+        if !deadlocked(&support, margins, &lifting, boundary) {
+            return lifting;
+        }
+        let rule_2: [bool; 6] = std::array::from_fn(|l| support[l] && self.neighbours[l].is_some_and(|(a, b)| support[a] && support[b]));
+        let fallback = self.stable_lifts(rule_2, margins, &support, estimated);
+        let first = (0..6).filter(|&l| fallback[l]).min_by(|&a, &b| margins[a].total_cmp(&margins[b]));
+        std::array::from_fn(|l| Some(l) == first)
+    }
+
+    /// Among `candidates`, in order of increasing margin, the legs whose lift leaves the body
+    /// centre inside the polygon of the feet still in support by the stability margin.
+    fn stable_lifts(&self, candidates: [bool; 6], margins: &[f64; 6], support: &[bool; 6], estimated: &Htm) -> [bool; 6] {
         let mut order: Vec<usize> = (0..6).filter(|&l| candidates[l]).collect();
         order.sort_by(|&a, &b| margins[a].total_cmp(&margins[b]));
-        let mut support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
+        let mut support = *support;
         let centre = estimated.translation.xy();
         let mut lifting = [false; 6];
         for l in order {
@@ -249,6 +281,29 @@ impl FreeGaitController {
         }
         lifting
     }
+}
+
+/// Beyond the thesis: with a failed leg, the footholds of the five working legs are offset
+/// towards the failed leg by a fifth of its workspace centre's horizontal distance from the body
+/// centre (body frame), so that the body centre stands over the centroid of the five workspace
+/// centres instead of the six; zero offsets on six legs (the thesis' AEP of Section 7.7.3).
+///
+/// INTERPRETATION: the thesis is silent on five legs. With the footholds of the six-legged
+/// gait, the diagonal of the support polygon between the front and rear feet of the side
+/// without the failed leg's neighbour on it passes through the body centre (the feet sit at
+/// ±30°, 90°, ±150°); lifting the other foot of the failed leg's side leaves the centre on that
+/// diagonal, 36 mm outside with leg 2 failed, and the walk deadlocks for good. Shifting the
+/// body towards the side with three legs, over the centroid of the support, is the standard
+/// remedy of fault-tolerant and quadruped gaits (the body sway of the quadruped crawl gaits;
+/// J.-M. Yang and J.-H. Kim, "Fault-tolerant locomotion of the hexapod robot", IEEE Trans.
+/// SMC-B 28(1), 1998, for a hexapod with a locked leg). Here it is done by the footholds, so
+/// the body keeps the commanded heading: each foot lands offset in its workspace and moves
+/// along the chord through its offset centre.
+fn foothold_offsets(options: &FreeGaitOptions, legs: &[LegKinematics; 6], workspaces: &[Workspace; 6]) -> [Vector3<f64>; 6] {
+    let Some(failed) = options.failed_leg else { return [Vector3::zeros(); 6] };
+    let c = legs[failed].to_body(&workspaces[failed].centre_at(-options.body_height));
+    let shift = Vector3::new(c.x, c.y, 0.0) / 5.0;
+    std::array::from_fn(|l| if l == failed { Vector3::zeros() } else { legs[l].direction_to_leg(&shift) })
 }
 
 impl Controller for FreeGaitController {
@@ -365,12 +420,13 @@ impl Controller for FreeGaitController {
         let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
         // A neighbour's step: takeoff, swing and a landing as long as the takeoff on flat ground.
         let reserve = speed_max * (2.0 * o.takeoff_time + o.swing_time);
-        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours, reserve), &margins, &estimated);
+        let boundary = speed_max * o.dt;
+        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours, reserve), &margins, &estimated, boundary);
         for l in (0..6).filter(|&l| lifting[l]) {
             let leg = &mut self.walk.legs[l];
             (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);
         }
-        self.state.deadlock = deadlocked(&support, &margins, &lifting, speed_max * o.dt);
+        self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary);
         self.state.deadlocked_periods += usize::from(self.state.deadlock);
 
         // The posture as the controller knows it.
