@@ -118,7 +118,8 @@ pub struct FreeGaitState {
     pub deadlocked_periods: usize,
     /// Elevator reflexes so far ([`super::elevator`]).
     pub elevations: usize,
-    /// A landing foot was at the bottom of its leg's reach: the body goes down with it.
+    /// A landing foot went a lift below the ground level of the posture, or to the bottom of
+    /// its leg's reach, without finding the ground: the body goes down.
     pub reaching_down: bool,
 }
 
@@ -327,12 +328,15 @@ impl Controller for FreeGaitController {
             let omega_post = rotation * Vector3::new(local.y, local.z, 0.0);
             corrected_velocities(&h.velocity, &Vector3::new(0.0, 0.0, h.yaw_rate), &v_post, &omega_post, &n)
         };
-        // INTERPRETATION (beyond the thesis, issue 11): a landing foot at the bottom of its leg's
-        // reach has not found the ground (a step down deeper than the leg reaches from the body
-        // height): the body goes down along its z axis at the landing speed, so that the foot
-        // goes on down at that speed, while the support feet have room above them in their
-        // reach (the posture control of the next touchdown then puts the body back at its
-        // height over the new contacts). It is a vertical motion, kept while deadlocked.
+        // INTERPRETATION (beyond the thesis, issue 11): a landing foot that has gone one lift
+        // below the ground level of the posture (z = −body height, leg frame) without finding
+        // the ground meets a step down that may be deeper than the leg reaches from the body
+        // height: the body goes down along its z axis at the landing speed, while the support
+        // feet have room above them in their reach (the posture control of the next touchdown
+        // then puts the body back at its height over the new contacts). The leg goes on
+        // lowering its foot (the landing detection from the currents needs the vertical joint
+        // sliding down, Section 5.6.3) until the bottom of its reach, where it holds. It is a
+        // vertical motion, kept while deadlocked.
         if self.state.reaching_down {
             v_b -= rotation * Vector3::z() * landing_speed;
         }
@@ -419,6 +423,7 @@ impl Controller for FreeGaitController {
                         leg.descent += landing_speed * o.dt;
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z -= leg.descent;
+                        reaching_down |= p.z < -o.body_height - o.lift;
                         p
                     }
                 }
@@ -431,7 +436,7 @@ impl Controller for FreeGaitController {
             // Eq. 7.7 from the previous references.
             let mut ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
             if self.working(l) && leg.phase == FootPhase::Landing && leg.foot.z < -o.body_height && !ik.is_reached() {
-                // The landing foot at the bottom of its reach: it stays there, and the body goes
+                // The landing foot at the bottom of its reach: it stays there while the body goes
                 // down (see above).
                 leg.descent -= landing_speed * o.dt;
                 leg.foot.z += landing_speed * o.dt;
