@@ -67,6 +67,24 @@ impl GroundDetector {
     pub fn estimate(&self) -> Option<&TorqueEstimate> {
         self.estimator.estimate()
     }
+
+    /// The ground force on each foot (leg frame, N) from the last update's ground torques of
+    /// its three joints: Eq. 5.20 with the whole J^{−T} (Eq. 5.22 keeps its vertical row), as the
+    /// elevator reflex of the free gait reads the horizontal resistance to the swing. None
+    /// before the first update or where J is singular.
+    pub fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; LEG_COUNT]> {
+        let e = self.estimator.estimate()?;
+        Some(std::array::from_fn(|leg| foot_force(&self.legs[leg], e, leg)))
+    }
+}
+
+/// F = −J^{−T} τ_gnd (Eq. 5.20, the force on the foot) from the estimated ground torques of `leg`.
+fn foot_force(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize) -> Option<Vector3<f64>> {
+    let k = 3 * leg;
+    let q = Vector3::new(e.q[k], e.q[k + 1], e.q[k + 2]);
+    let tau_gnd = Vector3::new(e.ground(k), e.ground(k + 1), e.ground(k + 2));
+    let j_inv_t: Matrix3<f64> = kinematics.jacobian(&q).transpose().try_inverse()?;
+    Some(-(j_inv_t * tau_gnd))
 }
 
 fn detect(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize, threshold: f64) -> LegDetection {

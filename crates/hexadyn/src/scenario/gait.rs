@@ -114,6 +114,7 @@ struct RawFree {
     landing_threshold_n: Option<f64>,
     failed_leg: Option<i64>,
     stability_margin_m: Option<f64>,
+    elevator: Option<bool>,
 }
 
 /// Kind of heading source in `[gait.heading]`.
@@ -467,7 +468,8 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [Leg
     };
     let stability_margin = raw.stability_margin_m.unwrap_or(DEFAULT_STABILITY_MARGIN_M);
     c.check(stability_margin.is_finite() && stability_margin >= 0.0, "gait.free.stability_margin_m", stability_margin, "a distance >= 0 m")?;
-    let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, dt };
+    let elevator = raw.elevator.unwrap_or(true);
+    let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, dt, elevator };
     let footholds: [Vector3<f64>; 6] = std::array::from_fn(|l| {
         let w = &workspaces[l];
         if failed_leg == Some(l) {

@@ -12,6 +12,8 @@
 
 use nalgebra::{Vector2, Vector3};
 
+use super::elevator::{resistance, retreat, ELEVATOR_FORCE};
+use super::landing::SETTLING_TIME_CONSTANTS;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture, PostureCorrection};
 use super::rules::{deadlocked, neighbours, stability_margin, swing_candidates};
@@ -21,7 +23,7 @@ use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
-use crate::control::{pi_command, Command, Controller, DigitalPi, Measurements};
+use crate::control::{pi_command, Command, Controller, DigitalPi, Measurements, DIGITAL_CUTOFF_HZ};
 use crate::hexapod::{LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -35,6 +37,12 @@ use crate::spatial::Htm;
 /// and a foot landing on the boundary starts its support outside its workspace, lifts again at
 /// once (lowest margin, Rule 3) and keeps a neighbour at its boundary deadlocked. 1 cm.
 pub const AEP_SECURITY: f64 = 0.01;
+
+/// Room (m) the support feet keep below the top of their reach when the body goes down after a
+/// landing foot at the bottom of its reach.
+///
+/// INTERPRETATION: the security margin of the working volume ([`AEP_SECURITY`]).
+pub const REACH_ROOM: f64 = AEP_SECURITY;
 
 /// Parameters of the free gait.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,6 +66,9 @@ pub struct FreeGaitOptions {
     pub stability_margin: f64,
     /// Control period Δt (s).
     pub dt: f64,
+    /// The elevator reflex of the swing ([`super::elevator`], beyond the thesis): a swinging
+    /// foot stopped by an obstacle rises by the lift and goes on.
+    pub elevator: bool,
 }
 
 /// The state of one leg.
@@ -71,8 +82,18 @@ pub struct Leg {
     contact: Vector3<f64>,
     /// Time spent in the current phase (s).
     elapsed: f64,
-    /// Foot reference (leg frame) at the start of the swing, p_PEP,takeoff of Eq. 7.31.
+    /// Foot reference (leg frame) at the start of the swing, p_PEP,takeoff of Eq. 7.31 (after
+    /// an elevator reflex, where the foot swings on from).
     pep: Vector3<f64>,
+    /// Duration of the swing from `pep` (s): the swing time, or what was left of it when an
+    /// elevator reflex began.
+    swing_time: f64,
+    /// Height (leg frame) the foot rises to while an elevator reflex lifts it.
+    rise_to: Option<f64>,
+    /// How far the landing foot has gone down below its virtual anchor (m).
+    descent: f64,
+    /// How long the swing has been resisted above the elevator threshold without a break (s).
+    resisted: f64,
     /// Current foot reference (leg frame) and joint references.
     foot: Vector3<f64>,
     joints: Vector3<f64>,
@@ -95,6 +116,11 @@ pub struct FreeGaitState {
     pub postures: usize,
     /// Instants spent deadlocked so far.
     pub deadlocked_periods: usize,
+    /// Elevator reflexes so far ([`super::elevator`]).
+    pub elevations: usize,
+    /// A landing foot went a lift below the ground level of the posture, or to the bottom of
+    /// its leg's reach, without finding the ground: the body goes down.
+    pub reaching_down: bool,
 }
 
 /// The free gait controller of Section 7.7.
@@ -108,6 +134,8 @@ pub struct FreeGaitController {
     neighbours: [Option<(usize, usize)>; 6],
     /// Offset of each leg's footholds from its workspace centre (leg frame): zero on six legs.
     foothold_offset: [Vector3<f64>; 6],
+    /// Highest foot of each leg's reach (leg frame, m).
+    reach_top: [f64; 6],
     walk: Walk<Leg>,
     /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
     posture: (Vector3<f64>, f64),
@@ -125,9 +153,10 @@ impl FreeGaitController {
         landing: Box<dyn LandingDetector>,
     ) -> Self {
         let z = Vector3::zeros();
-        let idle = Leg { phase: FootPhase::Support, anchor: z, contact: z, elapsed: 0.0, pep: z, foot: z, joints: z };
+        let idle = Leg { phase: FootPhase::Support, anchor: z, contact: z, elapsed: 0.0, pep: z, swing_time: options.swing_time, rise_to: None, descent: 0.0, resisted: 0.0, foot: z, joints: z };
         let neighbours = neighbours(options.failed_leg);
         let foothold_offset = foothold_offsets(&options, &legs, &workspaces);
+        let reach_top = std::array::from_fn(|l| legs[l].height_range().1);
         FreeGaitController {
             options,
             legs_kinematics: legs,
@@ -137,6 +166,7 @@ impl FreeGaitController {
             landing,
             neighbours,
             foothold_offset,
+            reach_top,
             walk: Walk { body: None, legs: [idle; 6] },
             posture: (z, f64::NEG_INFINITY),
             state: FreeGaitState::default(),
@@ -146,6 +176,11 @@ impl FreeGaitController {
 
     pub fn state(&self) -> FreeGaitState {
         self.state
+    }
+
+    /// True when the foot reference `p` (leg frame) is within the leg's reach (Eq. 7.7 from `q`).
+    fn reaches(&self, leg: usize, p: &Vector3<f64>, q: &Vector3<f64>) -> bool {
+        self.legs_kinematics[leg].inverse(p, q).is_ok_and(|ik| ik.is_reached())
     }
 
     fn working(&self, leg: usize) -> bool {
@@ -175,7 +210,7 @@ impl FreeGaitController {
             let foot = self.legs_kinematics[l].foot(&q);
             let anchor = self.leg_frame(l, &htm).apply(&foot);
             let phase = if self.working(l) { FootPhase::Support } else { FootPhase::Swing };
-            self.walk.legs[l] = Leg { phase, anchor, contact: anchor, elapsed: 0.0, pep: foot, foot, joints: q };
+            self.walk.legs[l] = Leg { phase, anchor, contact: anchor, elapsed: 0.0, pep: foot, swing_time: self.options.swing_time, rise_to: None, descent: 0.0, resisted: 0.0, foot, joints: q };
         }
         self.walk.body = Some(BodyMotion::new(pose));
     }
@@ -315,6 +350,8 @@ impl Controller for FreeGaitController {
             self.start(m);
         }
         let contact = self.landing.ground_contact(m);
+        let forces = self.landing.foot_forces();
+        let settling = SETTLING_TIME_CONSTANTS / (std::f64::consts::TAU * DIGITAL_CUTOFF_HZ);
         let before = self.walk.body.as_ref().expect("started").pose;
         let estimated = estimated_pose(m, &before);
 
@@ -335,7 +372,8 @@ impl Controller for FreeGaitController {
 
         // Section 7.7.2: the corrected global velocities; zero while deadlocked (Section 7.7.4).
         let rotation = before.htm().rotation;
-        let (v_b, omega_b) = if self.state.deadlock {
+        let landing_speed = o.lift / o.takeoff_time;
+        let (mut v_b, omega_b) = if self.state.deadlock {
             (Vector3::zeros(), Vector3::zeros())
         } else {
             let (local, until) = self.posture;
@@ -345,6 +383,18 @@ impl Controller for FreeGaitController {
             let omega_post = rotation * Vector3::new(local.y, local.z, 0.0);
             corrected_velocities(&h.velocity, &Vector3::new(0.0, 0.0, h.yaw_rate), &v_post, &omega_post, &n)
         };
+        // INTERPRETATION (beyond the thesis, issue 11): a landing foot that has gone one lift
+        // below the ground level of the posture (z = −body height, leg frame) without finding
+        // the ground meets a step down that may be deeper than the leg reaches from the body
+        // height: the body goes down along its z axis at the landing speed, while the support
+        // feet have room above them in their reach (the posture control of the next touchdown
+        // then puts the body back at its height over the new contacts). The leg goes on
+        // lowering its foot (the landing detection from the currents needs the vertical joint
+        // sliding down, Section 5.6.3) until the bottom of its reach, where it holds. It is a
+        // vertical motion, kept while deadlocked.
+        if self.state.reaching_down {
+            v_b -= rotation * Vector3::z() * landing_speed;
+        }
         if !first {
             // Eq. 7.12-7.23.
             self.walk.body.as_mut().expect("started").step(v_b, omega_b, o.dt);
@@ -353,8 +403,8 @@ impl Controller for FreeGaitController {
         let desired = body.pose.htm();
         let estimated = estimated_pose(m, &body.pose);
 
-        let landing_speed = o.lift / o.takeoff_time;
         let mut references = [0.0; JOINTS];
+        let (mut reaching_down, mut room) = (false, f64::INFINITY);
         let mut margins = [f64::INFINITY; 6];
         let mut speed_max = 0.0f64;
         for l in 0..6 {
@@ -374,7 +424,23 @@ impl Controller for FreeGaitController {
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z += landing_speed * leg.elapsed.min(o.takeoff_time);
                         if leg.elapsed >= o.takeoff_time - 0.5 * o.dt {
-                            (leg.phase, leg.elapsed, leg.pep) = (FootPhase::Swing, 0.0, p);
+                            (leg.phase, leg.elapsed, leg.pep, leg.swing_time) = (FootPhase::Swing, 0.0, p, o.swing_time);
+                        }
+                        p
+                    }
+                    // The elevator reflex: up at the takeoff's speed, held horizontally, to the
+                    // height it aims at or as high as the leg reaches; then the swing goes on
+                    // from there.
+                    FootPhase::Swing if leg.rise_to.is_some() => {
+                        let mut p = leg.foot;
+                        let top = leg.rise_to.unwrap_or(p.z);
+                        p.z = (p.z + landing_speed * o.dt).min(top);
+                        let reached = self.reaches(l, &p, &leg.joints);
+                        if !reached {
+                            p.z = leg.foot.z;
+                        }
+                        if !reached || p.z >= top {
+                            (leg.rise_to, leg.pep, leg.elapsed) = (None, p, 0.0);
                         }
                         p
                     }
@@ -382,21 +448,37 @@ impl Controller for FreeGaitController {
                     // step; the foot height stays that of the end of the takeoff.
                     FootPhase::Swing => {
                         let aep = self.aep(l, &v_c, leg.pep.z);
-                        let v = (aep - leg.pep) / o.swing_time;
-                        let mut p = leg.foot + Vector3::new(v.x, v.y, 0.0) * o.dt;
-                        p.z = leg.pep.z;
-                        if leg.elapsed >= o.swing_time - 0.5 * o.dt {
-                            // The landing: a virtual anchor where the foot is, so that the support
-                            // algorithm runs while the foot descends (Section 7.6).
-                            (leg.phase, leg.elapsed) = (FootPhase::Landing, 0.0);
-                            leg.anchor = self.leg_frame(l, &estimated).apply(&p);
+                        let pushed = forces.and_then(|f| f[l]).map_or(0.0, |f| resistance(&f, &(aep - leg.pep)));
+                        leg.resisted = if pushed > ELEVATOR_FORCE && leg.elapsed >= settling - 0.5 * o.dt { leg.resisted + o.dt } else { 0.0 };
+                        let settled = leg.resisted >= settling - 0.5 * o.dt;
+                        let measured = self.legs_kinematics[l].foot(&joints_of(m, l));
+                        let back = retreat(&leg.foot, &measured, &(aep - leg.pep));
+                        if o.elevator && settled && self.reaches(l, &(back + Vector3::z() * (0.5 * o.lift)), &leg.joints) {
+                            // An obstacle: back off and rise (super::elevator) in the swing
+                            // time that is left.
+                            leg.swing_time = (leg.swing_time - leg.elapsed).max(o.takeoff_time);
+                            (leg.rise_to, leg.resisted) = (Some(back.z + o.lift), 0.0);
+                            self.state.elevations += 1;
+                            back
+                        } else {
+                            let v = (aep - leg.pep) / leg.swing_time;
+                            let mut p = leg.foot + Vector3::new(v.x, v.y, 0.0) * o.dt;
+                            p.z = leg.pep.z;
+                            if leg.elapsed >= leg.swing_time - 0.5 * o.dt {
+                                // The landing: a virtual anchor where the foot is, so that the
+                                // support algorithm runs while the foot descends (Section 7.6).
+                                (leg.phase, leg.elapsed, leg.descent) = (FootPhase::Landing, 0.0, 0.0);
+                                leg.anchor = self.leg_frame(l, &estimated).apply(&p);
+                            }
+                            p
                         }
-                        p
                     }
                     // Down at constant speed until the ground is detected.
                     FootPhase::Landing => {
+                        leg.descent += landing_speed * o.dt;
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
-                        p.z -= landing_speed * leg.elapsed;
+                        p.z -= leg.descent;
+                        reaching_down |= p.z < -o.body_height - o.lift;
                         p
                     }
                 }
@@ -404,9 +486,18 @@ impl Controller for FreeGaitController {
             if self.working(l) && leg.phase == FootPhase::Support {
                 margins[l] = self.margin(l, &leg.foot, &v_c);
                 speed_max = speed_max.max(v_c.xy().norm());
+                room = room.min(self.reach_top[l] - leg.foot.z);
             }
             // Eq. 7.7 from the previous references.
-            let ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
+            let mut ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
+            if self.working(l) && leg.phase == FootPhase::Landing && leg.foot.z < -o.body_height && !ik.is_reached() {
+                // The landing foot at the bottom of its reach: it stays there while the body goes
+                // down (see above).
+                leg.descent -= landing_speed * o.dt;
+                leg.foot.z += landing_speed * o.dt;
+                ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
+                reaching_down = true;
+            }
             if !ik.is_reached() {
                 self.diagnostics.clamped_references += 1;
                 self.diagnostics.last_clamped_at = Some(m.t);
@@ -428,6 +519,7 @@ impl Controller for FreeGaitController {
         }
         self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary);
         self.state.deadlocked_periods += usize::from(self.state.deadlock);
+        self.state.reaching_down = reaching_down && room > REACH_ROOM;
 
         // The posture as the controller knows it.
         let to_body = estimated.inverse();

@@ -7,6 +7,8 @@
 
 use std::f64::consts::TAU;
 
+use nalgebra::Vector3;
+
 use crate::control::{GroundDetector, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
 use crate::description::RobotDescription;
 use crate::hexapod::{Joint, LegKinematicsError};
@@ -16,6 +18,13 @@ use crate::hexapod::{Joint, LegKinematicsError};
 /// time) and reads its answer for the legs that are landing.
 pub trait LandingDetector: Send {
     fn ground_contact(&mut self, m: &Measurements) -> [bool; 6];
+
+    /// The ground force on each foot (leg frame, N) estimated from the measurements at the
+    /// last [`Self::ground_contact`], when the detector estimates it (the elevator reflex of
+    /// the swing reads it, [`super::elevator`]).
+    fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; 6]> {
+        None
+    }
 }
 
 /// The simulation mode of Section 7.7: the ground is detected when the true normal force on the
@@ -108,13 +117,16 @@ impl LandingDetector for MotorCurrent {
             d.detected && self.sliding[l] >= self.settling - 0.5 * self.dt
         })
     }
+
+    fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; 6]> {
+        self.detector.foot_forces()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::hexapod::LegKinematics;
-    use nalgebra::Vector3;
 
     /// The six legs going down from q_v = 0.05 m at `qd_v` (m/s) for `n` control periods with
     /// the motor current `current` (A) of their vertical joints, the other joints still and

@@ -5,6 +5,7 @@
 //! failed leg.
 
 mod controller;
+pub mod elevator;
 pub mod landing;
 pub mod posture;
 pub mod rules;
