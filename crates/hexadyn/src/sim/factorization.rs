@@ -17,9 +17,11 @@ use nalgebra::{DMatrix, DVector, Dyn, LU};
 /// eliminated (the second-order coordinates). This is the growth bound of threshold partial
 /// pivoting with threshold u = `PIVOT_THRESHOLD` (an entry of S grows by at most 1/u times the
 /// largest entry of A for each eliminated state that updates it), and unlike a test of |J_tt|
-/// against its own row and column it does not depend on the units of the state: a LuGre bristle row (in m/s) against the stiff column σ0 γh (in N/m · s) of a
-/// nut joint passes it, its update σ0 γ²h² / J_tt being of the size of the reflected rotor
-/// inertias it is added to.
+/// against its own row and column it does not depend on the units of the state: a LuGre
+/// bristle row (in m/s) against the stiff column σ0 γh (in N/m · s) of a nut joint passes it,
+/// its update σ0 γ²h² / J_tt being of the size of the reflected rotor inertias it is added to
+/// (the dominance test kept 12 of the 18 bristles of the 75 s walk in the LU: 36 × 36 instead
+/// of 24 × 24).
 const PIVOT_THRESHOLD: f64 = 1e-3;
 
 /// Whether first-order state `i` can be eliminated: no coupling to another first-order state and
