@@ -104,6 +104,7 @@ impl Axis {
         }
     }
     /// R ← R R_e(θ), with the sine and cosine of θ.
+    #[inline]
     pub fn rotate(&self, r: &mut Matrix3<f64>, (s, c): (f64, f64)) {
         match self {
             Axis::Frame(k) => {

@@ -99,6 +99,10 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
     for (sc, var) in data.angles.iter_mut().zip(&model.angles) {
         *sc = var_state(var, q, qd, &data.dependents).value.sin_cos();
     }
+    // The relative partial velocities are accumulated below: zeroed once for all bodies (one
+    // fill rather than a small one per body).
+    data.d_rel.fill(Vector3::zeros());
+    data.delta_rel.fill(Vector3::zeros());
     for (i, body) in model.bodies.iter().enumerate() {
         let (mut pose, mut omega, mut vel, mut alpha, mut acc) = match body.parent {
             Some(p) => (data.pose[p], data.omega[p], data.velocity[p], data.alpha_bias[p], data.accel_bias[p]),
@@ -109,8 +113,6 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
         let n = body.own.len();
         let d = &mut data.d_rel[body.own_offset..body.own_offset + n];
         let delta = &mut data.delta_rel[body.own_offset..body.own_offset + n];
-        d.iter_mut().for_each(|x| *x = Vector3::zeros());
-        delta.iter_mut().for_each(|x| *x = Vector3::zeros());
         // Displacements are carried rigidly with ω, α and δ of the frame, which only a rotation
         // changes: those up to the next rotation are summed and carried once (Eq. 3.24-3.27
         // are linear in the displacement).

@@ -11,10 +11,38 @@
 
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 
-/// A decoupled state is eliminated only when its diagonal entry is at least this fraction of
-/// the largest entry of its row and of its column: the pivot partial pivoting would also take
-/// first, so that the reduction is as accurate as the full LU.
-const PIVOT_DOMINANCE: f64 = 1e-3;
+/// A decoupled state t is eliminated only when its pivot keeps the element growth of the
+/// elimination bounded: the largest update of the Schur complement, max|J_kt| · max|J_tl| / |J_tt|,
+/// is at most 1 / `PIVOT_THRESHOLD` times the largest diagonal entry of the block that is never
+/// eliminated (the second-order coordinates). This is the growth bound of threshold partial
+/// pivoting with threshold u = `PIVOT_THRESHOLD` (an entry of S grows by at most 1/u times the
+/// largest entry of A for each eliminated state that updates it), and unlike a test of |J_tt|
+/// against its own row and column it does not depend on the units of the state: a LuGre
+/// bristle row (in m/s) against the stiff column σ0 γh (in N/m · s) of a nut joint passes it,
+/// its update σ0 γ²h² / J_tt being of the size of the reflected rotor inertias it is added to
+/// (the dominance test kept 12 of the 18 bristles of the 75 s walk in the LU: 36 × 36 instead
+/// of 24 × 24).
+const PIVOT_THRESHOLD: f64 = 1e-3;
+
+/// Whether first-order state `i` can be eliminated: no coupling to another first-order state and
+/// a pivot that bounds the growth against `kept` (see [`PIVOT_THRESHOLD`]). One pass over its
+/// row and column.
+fn eliminable(j: &DMatrix<f64>, first_order: &[bool], i: usize, kept: f64) -> bool {
+    // Column-major storage: column i is contiguous, row i strided by n.
+    let (n, entries) = (j.nrows(), j.as_slice());
+    let own_column = &entries[i * n..(i + 1) * n];
+    let (mut column, mut row, mut coupled) = (0.0_f64, 0.0_f64, false);
+    for k in 0..n {
+        if k != i {
+            let (down, across) = (own_column[k].abs(), entries[k * n + i].abs());
+            column = if down > column { down } else { column };
+            row = if across > row { across } else { row };
+            coupled |= first_order[k] & (down != 0.0 || across != 0.0);
+        }
+    }
+    let diagonal = j[(i, i)].abs();
+    diagonal > 0.0 && !coupled && column * row * PIVOT_THRESHOLD <= diagonal * kept
+}
 
 /// LU factorization of J, on the Schur complement when first-order states can be eliminated.
 #[derive(Clone, Debug)]
@@ -44,16 +72,14 @@ struct Reduced {
 
 impl Factorization {
     /// Factorizes `j`, eliminating the `first_order` coordinates that are decoupled from every
-    /// other first-order coordinate and hold a dominant diagonal. None when J is singular.
+    /// other first-order coordinate and whose pivot bounds the growth (see [`PIVOT_THRESHOLD`]).
+    /// None when J is singular.
     pub(crate) fn new(j: DMatrix<f64>, first_order: &[bool]) -> Option<Self> {
         let n = j.nrows();
-        let candidates: Vec<usize> = (0..n).filter(|&i| first_order[i]).collect();
-        let decoupled = |i: usize| {
-            let diagonal = j[(i, i)].abs();
-            let dominant = (0..n).all(|k| j[(i, k)].abs() * PIVOT_DOMINANCE <= diagonal && j[(k, i)].abs() * PIVOT_DOMINANCE <= diagonal);
-            diagonal > 0.0 && dominant && candidates.iter().all(|&k| k == i || (j[(i, k)] == 0.0 && j[(k, i)] == 0.0))
-        };
-        let t: Vec<usize> = candidates.iter().copied().filter(|&i| decoupled(i)).collect();
+        // The largest diagonal entry of the block never eliminated: a lower bound of its largest
+        // entry, so that the test is the stricter for it.
+        let kept = (0..n).filter(|&r| !first_order[r]).fold(0.0_f64, |m, r| m.max(j[(r, r)].abs()));
+        let t: Vec<usize> = (0..n).filter(|&i| first_order[i] && eliminable(&j, first_order, i, kept)).collect();
         // Nothing to eliminate, or nothing left (a diagonal J): the full LU.
         if t.is_empty() || t.len() == n {
             let lu = LU::new(j);
@@ -90,28 +116,33 @@ impl Factorization {
         lu.is_invertible().then_some(Factorization { kind: Kind::Reduced(Reduced { a, t, d, b, c, lu }) })
     }
 
-    /// x with J x = r; None when the factorization cannot solve it.
+    /// x with J x = r; None when the factorization cannot solve it. Solved in place: one
+    /// allocation for x, one for x_a.
     pub(crate) fn solve(&self, r: &[f64]) -> Option<DVector<f64>> {
         match &self.kind {
-            Kind::Full(lu) => lu.solve(&DVector::from_column_slice(r)),
+            Kind::Full(lu) => {
+                let mut x = DVector::from_column_slice(r);
+                lu.solve_mut(&mut x).then_some(x)
+            }
             Kind::Reduced(s) => {
-                // r_t / D, then S x_a = r_a − B D⁻¹ r_t.
-                let rt: Vec<f64> = s.t.iter().zip(&s.d).map(|(&i, d)| r[i] / d).collect();
-                let mut ra = DVector::from_iterator(s.a.len(), s.a.iter().map(|&i| r[i]));
+                // S x_a = r_a − B D⁻¹ r_t.
+                let mut xa = DVector::from_iterator(s.a.len(), s.a.iter().map(|&i| r[i]));
                 for &(ka, kt, bv) in &s.b {
-                    ra[ka] -= bv * rt[kt];
+                    xa[ka] -= bv * (r[s.t[kt]] / s.d[kt]);
                 }
-                let xa = s.lu.solve(&ra)?;
-                let mut x = DVector::zeros(r.len());
+                if !s.lu.solve_mut(&mut xa) {
+                    return None;
+                }
+                // x_t = D⁻¹ (r_t − C x_a).
+                let mut x = DVector::from_column_slice(r);
                 for (ka, &i) in s.a.iter().enumerate() {
                     x[i] = xa[ka];
                 }
-                let mut xt: Vec<f64> = s.t.iter().map(|&i| r[i]).collect();
                 for &(kt, ka, cv) in &s.c {
-                    xt[kt] -= cv * xa[ka];
+                    x[s.t[kt]] -= cv * xa[ka];
                 }
                 for (kt, &i) in s.t.iter().enumerate() {
-                    x[i] = xt[kt] / s.d[kt];
+                    x[i] /= s.d[kt];
                 }
                 Some(x)
             }
@@ -152,6 +183,68 @@ mod tests {
         let f = Factorization::new(diagonal, &[true, true]).unwrap();
         assert!(matches!(f.kind, Kind::Full(_)));
         assert_eq!(f.solve(&[1.0, 1.0]).unwrap().as_slice(), &[0.5, 0.25]);
+    }
+
+    /// A LuGre bristle on a nut joint (Eq. 3.85 in the Newmark matrix, Eq. 3.14): its row in
+    /// m/s, its column σ0 γh = 1e9 · 2.5e-3 N/m·s in the joint row, far above its unit diagonal,
+    /// but its update σ0 γ²h² = 6250 kg of the size of the reflected rotor inertias: eliminated,
+    /// and the solve is the full LU's to rounding. The same state with a row a million times
+    /// larger would add 6.25e9 kg to a block of 2000: kept in the LU.
+    #[test]
+    fn stiff_bristle_is_eliminated_while_the_growth_stays_bounded() {
+        let j = DMatrix::from_row_slice(3, 3, &[
+            2000.0, 10.0, 2.5e6, //
+            10.0, 500.0, 0.0, //
+            -2.5e-3, 0.0, 1.0,
+        ]);
+        let r = [3.0, -1.0, 2e-4];
+        let full = LU::new(j.clone()).solve(&DVector::from_column_slice(&r)).unwrap();
+        let first = [false, false, true];
+        let reduced = Factorization::new(j.clone(), &first).unwrap();
+        assert!(matches!(&reduced.kind, Kind::Reduced(s) if s.t == [2]));
+        let x = reduced.solve(&r).unwrap();
+        for i in 0..3 {
+            assert!((x[i] - full[i]).abs() <= 1e-13 * full[i].abs(), "{x} vs {full}");
+        }
+        let mut swamping = j;
+        swamping[(2, 0)] = -2.5e3;
+        assert!(matches!(Factorization::new(swamping, &first).unwrap().kind, Kind::Full(_)));
+    }
+
+    /// Random Newmark matrices of the 42-DOF LuGre model's shape (Eq. 3.14): 24 coupled
+    /// coordinates with reflected inertias of 1 to 1e4 on the diagonal, one bristle per joint
+    /// (Eq. 3.85: row −γh on its joint's velocity, diagonal 1 + γh σ0 |v| / g, sticking to
+    /// sliding; column σ1 + γh σ0 in its joint row with σ0 from 1e4 to 1e9), h from 0.1 to
+    /// 10 ms. Every bristle is eliminated, and the reduced solve has the backward error of the
+    /// full LU: ‖J x − r‖ ≤ 1e-14 ‖J‖ ‖x‖ (row-sum norms).
+    #[test]
+    fn reduced_solve_is_backward_stable_on_lugre_shaped_matrices() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
+        let (na, nt) = (24, 18);
+        let n = na + nt;
+        for _ in 0..200 {
+            let (gamma_h, stiffness) = (0.5 * 10f64.powf(rng.random_range(-4.0..-2.0)), 10f64.powf(rng.random_range(4.0..9.0)));
+            let mut j = DMatrix::from_fn(n, n, |r, c| if r < na && c < na { rng.random_range(-1.0..1.0) } else { 0.0 });
+            for k in 0..na {
+                j[(k, k)] += 10f64.powf(rng.random_range(0.0..4.0));
+            }
+            for k in 0..nt {
+                let (joint, z) = (6 + k, na + k);
+                let sliding = rng.random_range(0.0..1.0) * 1e-3 * stiffness;
+                j[(z, z)] = 1.0 + gamma_h * sliding;
+                j[(z, joint)] = -gamma_h;
+                j[(joint, z)] = 1e3 * rng.random_range(0.0..1.0) + gamma_h * stiffness;
+            }
+            let r: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let first: Vec<bool> = (0..n).map(|i| i >= na).collect();
+            let f = Factorization::new(j.clone(), &first).unwrap();
+            assert!(matches!(&f.kind, Kind::Reduced(s) if s.t.len() == nt));
+            let x = f.solve(&r).unwrap();
+            let residual = (&j * &x - DVector::from_column_slice(&r)).amax();
+            let norm = (0..n).map(|i| j.row(i).iter().map(|v| v.abs()).sum::<f64>()).fold(0.0, f64::max);
+            assert!(residual <= 1e-14 * norm * x.amax(), "backward error {} (‖J‖ {norm:e}, ‖x‖ {:e})", residual / (norm * x.amax()), x.amax());
+        }
     }
 
     /// A singular matrix has no factorization, reduced or not.
