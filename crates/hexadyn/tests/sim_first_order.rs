@@ -262,9 +262,9 @@ fn logistic_growth_nonlinear_first_order() {
 /// zero-order hold) on a cart-pole, whose mass matrix changes with the pole angle: the pole is
 /// driven through ±0.8 rad, so the factorization of M kept from one reset to the next goes stale.
 /// After every reset q'' solves M(q) q'' = rhs(q, q', u) (closed form, 2 × 2) within the Newton
-/// test of the steps (1 % of q'' plus tolerance · newton_tolerance / (β h²)), whether the reset
-/// was verified or took a single correction with the predicted contraction (a single correction
-/// trusted for nine resets after each verified one was off by up to 194 times that).
+/// test of the steps (1 % of q'' plus tolerance · newton_tolerance / (β h²)). (A reset stopped
+/// after a single correction trusted for nine resets after each verified one was off by up to 194
+/// times that; see docs/performance-log.md.)
 #[test]
 fn consistent_accelerations_at_every_control_instant() {
     let mut sys = CartPole::new();

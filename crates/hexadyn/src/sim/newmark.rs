@@ -11,10 +11,6 @@ use super::{Jacobian, Order, SimError, System};
 /// accelerations is at least this many times smaller than the one before.
 const FAST_CONTRACTION: f64 = 0.1;
 
-/// Margin on the contraction of the consistent accelerations predicted from the last verified
-/// reset (see [`Newmark::reset_accelerations`]).
-const CONTRACTION_MARGIN: f64 = 2.0;
-
 /// Integration parameters. Defaults: the trapezoidal rule β = 1/4, γ = 1/2 (unconditionally
 /// stable for linear systems, second order, no numerical damping).
 #[derive(Clone, Debug, PartialEq)]
@@ -107,11 +103,6 @@ pub struct Newmark {
     jacobian_fresh: bool,
     /// Factorization of M = ∂f/∂q'' kept for [`Self::reset_accelerations`].
     mass_lu: Option<Factorization>,
-    /// Resets of the accelerations since `mass_lu` was factorized.
-    mass_age: usize,
-    /// The ratio of the second to the first correction of the consistent accelerations with
-    /// `mass_lu`, measured at the last verified reset, and `mass_age` then.
-    mass_contraction: Option<(f64, usize)>,
     stats: NewmarkStats,
     work: Work,
 }
@@ -146,8 +137,6 @@ impl Newmark {
             lu: None,
             jacobian_fresh: false,
             mass_lu: None,
-            mass_age: 0,
-            mass_contraction: None,
             stats: NewmarkStats::default(),
             work: Work { f: vec![0.0; n], q: DVector::zeros(n), qd: DVector::zeros(n), qdd: DVector::zeros(n), weight_q: DVector::zeros(n) },
         };
@@ -181,23 +170,7 @@ impl Newmark {
     /// The factorization of M is kept from one call to the next (the configuration moves little
     /// between control instants) and refreshed only when the iteration with it does not contract
     /// fast: modified Newton, as in the steps.
-    ///
-    /// A mechanical residual is affine in q'' at a given (q, q'): M(q) q'' in the multibody rows
-    /// (Eq. 3.39), σ1 z' in a LuGre torque (Eq. 3.87), z' in a bristle row (Eq. 3.85), L i' in a
-    /// motor row (Eq. 3.91). One correction with the exact M then lands on the consistent q'';
-    /// with the kept M, the error left by a correction is the next one, the contraction of the
-    /// iteration times it, and the contraction is ‖I − M_kept⁻¹ M(q)‖, which grows with the
-    /// distance the configuration moved since M was factorized: about linearly with the number
-    /// of resets since then (its age). A verified reset (corrections until the Newton test passes)
-    /// measures the contraction at its age a; a later reset of age b ≤ 2a predicts it as the
-    /// measured one × b/a × [`CONTRACTION_MARGIN`] (the margin covers a growth up to quadratic,
-    /// a configuration accelerating from rest), and its first correction is the last when the
-    /// predicted next one passes the Newton test: one residual evaluation instead of two.
-    /// INTERPRETATION: the thesis (Section 3.3.2) does not say how the accelerations are made
-    /// consistent; benches/walk: on the 75 s LuGre walk the contraction is 1e-3 to 1e-2
-    /// (docs/performance-log.md).
     pub fn reset_accelerations<S: System + ?Sized>(&mut self, sys: &mut S) -> Result<(), SimError> {
-        self.mass_age += 1;
         if self.mass_lu.is_some() {
             let start = self.state.qdd.clone();
             if self.consistent_accelerations(sys, FAST_CONTRACTION)? {
@@ -211,7 +184,6 @@ impl Newmark {
             self.stats.jacobian_evaluations += 1;
         }
         self.mass_lu = Factorization::new(m, &self.first_order(sys));
-        (self.mass_age, self.mass_contraction) = (0, None);
         self.stats.factorizations += 1;
         if self.mass_lu.is_none() {
             return Ok(());
@@ -222,20 +194,13 @@ impl Newmark {
 
     /// Newton iterations q'' ← q'' − M⁻¹ f with the kept factorization of M, until the
     /// correction passes the Newton test of the next step (true) or is not at least
-    /// `contraction` times smaller than the one before (false). A first correction passes when
-    /// the one that the trusted contraction predicts after it passes (see
-    /// [`Self::reset_accelerations`]).
+    /// `contraction` times smaller than the one before (false).
     fn consistent_accelerations<S: System + ?Sized>(&mut self, sys: &mut S, contraction: f64) -> Result<bool, SimError> {
         let t = self.state.t;
         self.weights(sys);
         let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, self.h);
-        let age = self.mass_age;
-        let trusted = match self.mass_contraction {
-            Some((ratio, measured_at)) if age <= 2 * measured_at => Some(CONTRACTION_MARGIN * ratio * age as f64 / measured_at as f64),
-            _ => None,
-        };
         let mut previous = f64::INFINITY;
-        for iteration in 0..self.options.max_iterations {
+        for _ in 0..self.options.max_iterations {
             sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
             self.stats.residual_evaluations += 1;
             check_finite(sys, t, None, &self.work.f)?;
@@ -245,11 +210,6 @@ impl Newmark {
             };
             self.state.qdd -= &dx;
             let norm = test.norm(&dx, &self.work.weight_q);
-            match (iteration, trusted) {
-                (0, Some(ratio)) if test.converged(ratio * norm, &(ratio * &dx), &self.state.qdd) => return Ok(true),
-                (1, _) if age > 0 => self.mass_contraction = Some((norm / previous, age)),
-                _ => {}
-            }
             if test.converged(norm, &dx, &self.state.qdd) {
                 return Ok(true);
             }
