@@ -37,8 +37,18 @@ pub struct LegDetection {
 /// keeps α_21 alone: the pantograph decouples q_v (vertical) and q_h (horizontal), so α_22 is
 /// small.
 pub fn alpha(leg: &LegKinematics, q: &Vector3<f64>) -> Option<(f64, f64)> {
-    let j_inv_t: Matrix3<f64> = leg.jacobian(q).transpose().try_inverse()?;
+    let j_inv_t = jacobian_inverse_transpose(leg, q)?;
     Some((-j_inv_t[(2, 1)], -j_inv_t[(2, 2)]))
+}
+
+/// J^{−T} of the leg at q (Eq. 5.20: F = −J^{−T} τ); None where J is singular.
+fn jacobian_inverse_transpose(leg: &LegKinematics, q: &Vector3<f64>) -> Option<Matrix3<f64>> {
+    leg.jacobian(q).transpose().try_inverse()
+}
+
+/// The estimator's (filtered) joint positions of `leg`.
+fn leg_joints(e: &TorqueEstimate, leg: usize) -> Vector3<f64> {
+    Vector3::new(e.q[3 * leg], e.q[3 * leg + 1], e.q[3 * leg + 2])
 }
 
 /// The ground detector of the six legs.
@@ -81,15 +91,13 @@ impl GroundDetector {
 /// F = −J^{−T} τ_gnd (Eq. 5.20, the force on the foot) from the estimated ground torques of `leg`.
 fn foot_force(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize) -> Option<Vector3<f64>> {
     let k = 3 * leg;
-    let q = Vector3::new(e.q[k], e.q[k + 1], e.q[k + 2]);
     let tau_gnd = Vector3::new(e.ground(k), e.ground(k + 1), e.ground(k + 2));
-    let j_inv_t: Matrix3<f64> = kinematics.jacobian(&q).transpose().try_inverse()?;
-    Some(-(j_inv_t * tau_gnd))
+    Some(-(jacobian_inverse_transpose(kinematics, &leg_joints(e, leg))? * tau_gnd))
 }
 
 fn detect(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize, threshold: f64) -> LegDetection {
     let k = 3 * leg;
-    let q = Vector3::new(e.q[k], e.q[k + 1], e.q[k + 2]);
+    let q = leg_joints(e, leg);
     let tau_v_gnd = e.ground(k + 1);
     let force = alpha(kinematics, &q).map_or(0.0, |(a21, _)| a21 * tau_v_gnd);
     let qd_v = e.qd[k + 1];
