@@ -83,9 +83,11 @@ def test_robot_run_against_robot_emulate_on_loopback(tmp_path):
     scenario = shortened("stand_six_legs", tmp_path, 1.0)
     text = LOOPBACK.read_text()
     text = text.replace("127.0.0.1:47100", f"127.0.0.1:{free_udp_port()}").replace("127.255.255.255:47101", f"127.255.255.255:{free_udp_port()}")
-    # The test machine is shared: a late packet now and then must not stop the robot (the
-    # safety stops have their own tests in the engine).
-    text = text.replace("missing_periods = 3", "missing_periods = 10").replace("overrun_tolerance_s = 0.0", "overrun_tolerance_s = 0.005")
+    # The test machine is shared: a late packet or a descheduled controller now and then must
+    # not stop the robot (the safety stops have their own tests in the engine). The overrun
+    # tolerance is the most the configuration allows, just under the 10 ms period: a one-off
+    # 7.3 ms scheduling delay on an idle CI machine stopped the run at 5 ms.
+    text = text.replace("missing_periods = 3", "missing_periods = 10").replace("overrun_tolerance_s = 0.0", "overrun_tolerance_s = 0.0099")
     link = tmp_path / "link.toml"
     link.write_text(text)
     emulator = subprocess.Popen(
