@@ -1,7 +1,9 @@
 //! A terrain given as a triangle mesh, queried through parry3d-f64.
 
 use nalgebra::Vector3;
+use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVec;
+use parry3d_f64::partitioning::BvhNode;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags, TrianglePointLocation};
 
@@ -191,26 +193,38 @@ const VICINITY_MARGIN: f64 = 0.01;
 pub struct Vicinity {
     centre: PVec,
     pub(super) reach: f64,
-    faces: Vec<u32>,
+    /// The faces and their bounding boxes, the closest of the last query first.
+    faces: Vec<(u32, Aabb)>,
 }
 
 impl Vicinity {
     /// The closest point of the gathered faces to `c` (face, point, location) when it is the
     /// closest of the whole mesh (type docs); `None` otherwise.
-    fn closest(&self, mesh: &TriMesh, c: PVec) -> Option<(u32, PVec, TrianglePointLocation)> {
-        let mut best: Option<(u32, PVec, TrianglePointLocation)> = None;
-        // As parry3d's own search: the first face strictly closer than all before it.
+    fn closest(&mut self, mesh: &TriMesh, c: PVec) -> Option<(u32, PVec, TrianglePointLocation)> {
+        let mut best: Option<(usize, PVec, TrianglePointLocation)> = None;
         let mut best_distance = f64::MAX;
-        for &face in &self.faces {
-            let (projection, location) = mesh.triangle(face).project_local_point_and_get_location(c, false);
+        for (k, (face, aabb)) in self.faces.iter().enumerate() {
+            // A face whose box is farther than the closest point so far cannot be closer (the
+            // relative slack covers the rounding of both distances).
+            let outside = (aabb.mins - c).max(c - aabb.maxs).max(PVec::ZERO);
+            if outside.length_squared() > best_distance * best_distance * (1.0 + 1e-9) {
+                continue;
+            }
+            let (projection, location) = mesh.triangle(*face).project_local_point_and_get_location(c, false);
             let distance = (projection.point - c).length();
             if distance < best_distance {
-                best = Some((face, projection.point, location));
+                best = Some((k, projection.point, location));
                 best_distance = distance;
             }
         }
         // A nanometre of slack for the rounding of the bounding boxes' distances.
-        (c.distance(self.centre) + best_distance <= self.reach - 1e-9).then_some(best).flatten()
+        if c.distance(self.centre) + best_distance > self.reach - 1e-9 {
+            return None;
+        }
+        let (k, point, location) = best?;
+        // The next query, a little further along, starts from this face.
+        self.faces.swap(0, k);
+        Some((self.faces[0].0, point, location))
     }
 
     /// Gathers the faces whose bounding box comes within `reach` of `centre`.
@@ -218,6 +232,7 @@ impl Vicinity {
         self.centre = centre;
         self.reach = reach;
         self.faces.clear();
-        self.faces.extend(mesh.bvh().leaves(|node| node.aabb().distance_to_local_point(centre, true) <= reach));
+        let within = |node: &BvhNode| node.aabb().distance_to_local_point(centre, true) <= reach;
+        self.faces.extend(mesh.bvh().leaves(within).map(|face| (face, mesh.triangle(face).local_aabb())));
     }
 }
