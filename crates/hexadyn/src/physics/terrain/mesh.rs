@@ -199,10 +199,14 @@ pub struct Vicinity {
 
 impl Vicinity {
     /// The closest point of the gathered faces to `c` (face, point, location) when it is the
-    /// closest of the whole mesh (type docs); `None` otherwise.
+    /// closest of the whole mesh (type docs) and no other gathered face is as close; `None`
+    /// otherwise.
     fn closest(&mut self, mesh: &TriMesh, c: PVec) -> Option<(u32, PVec, TrianglePointLocation)> {
         let mut best: Option<(usize, PVec, TrianglePointLocation)> = None;
         let mut best_distance = f64::MAX;
+        // Two faces at exactly the closest distance (the closest point on their common edge):
+        // parry3d's search keeps the first it visits, so the vicinity leaves the choice to it.
+        let mut tie = false;
         for (k, (face, aabb)) in self.faces.iter().enumerate() {
             // A face whose box is farther than the closest point so far cannot be closer (the
             // relative slack covers the rounding of both distances).
@@ -215,10 +219,13 @@ impl Vicinity {
             if distance < best_distance {
                 best = Some((k, projection.point, location));
                 best_distance = distance;
+                tie = false;
+            } else {
+                tie |= distance == best_distance;
             }
         }
         // A nanometre of slack for the rounding of the bounding boxes' distances.
-        if c.distance(self.centre) + best_distance > self.reach - 1e-9 {
+        if tie || c.distance(self.centre) + best_distance > self.reach - 1e-9 {
             return None;
         }
         let (k, point, location) = best?;
