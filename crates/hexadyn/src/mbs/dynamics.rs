@@ -92,7 +92,10 @@ impl Composite {
 /// Algorithms, Section 6.2, on the relative partial velocities).
 pub fn mass_matrix(model: &Model, data: &Data, m: &mut DMatrix<f64>) {
     let n = model.coordinates;
-    m.view_mut((0, 0), (n, n)).fill(0.0);
+    let rows = m.nrows();
+    for column in m.as_mut_slice().chunks_mut(rows).take(n) {
+        column[..n].fill(0.0);
+    }
     let mut composite: Vec<Composite> = model.bodies.iter().enumerate().map(|(i, b)| Composite { mass: b.mass, first_moment: Vector3::zeros(), inertia: data.world_inertia[i] }).collect();
     // Descendants first (a body comes after its reference body).
     for (i, body) in model.bodies.iter().enumerate().rev() {
