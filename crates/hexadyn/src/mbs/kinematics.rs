@@ -118,7 +118,8 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
         // are linear in the displacement), and only when there are some. The relative δ are
         // zero up to the joint's first rotation: none to carry into d before it.
         let mut displacement = Vector3::zeros();
-        let (mut moved, mut turned) = (false, 0);
+        // `with_delta`: the own columns whose relative δ may be non-zero (all after a rotation).
+        let (mut moved, mut with_delta) = (false, 0);
         for e in &body.joint {
             match e {
                 CompiledElementary::Fixed(h) => {
@@ -132,7 +133,7 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
                 }
                 CompiledElementary::Rotation { axis, var, angle } => {
                     if moved {
-                        offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, &mut d[..turned], &delta[..turned]);
+                        offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, &mut d[..with_delta], &delta[..with_delta]);
                         pose.translation += displacement;
                         (displacement, moved) = (Vector3::zeros(), false);
                     }
@@ -141,7 +142,7 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
                     alpha += omega.cross(&e) * s.rate + e * s.bias;
                     omega += e * s.rate;
                     add_gradient(var, &data.dependents, &e, delta);
-                    turned = n;
+                    with_delta = n;
                     match angle {
                         Some(k) => axis.rotate(&mut pose.rotation, data.angles[*k]),
                         None => data.spin[i] = Some((*axis, s.value)),
@@ -159,7 +160,7 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
             }
         }
         if moved {
-            offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, &mut d[..turned], &delta[..turned]);
+            offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, &mut d[..with_delta], &delta[..with_delta]);
             pose.translation += displacement;
         }
         data.world_inertia[i] = world_inertia(&pose.rotation, &body.inertia, body.principal.as_ref());
