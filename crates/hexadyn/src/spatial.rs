@@ -106,21 +106,17 @@ impl Axis {
     /// R ← R R_e(θ), with the sine and cosine of θ.
     #[inline]
     pub fn rotate(&self, r: &mut Matrix3<f64>, (s, c): (f64, f64)) {
+        // About axis k the columns i = k + 1 and j = k + 2 (cyclic) turn:
+        // c_i' = c c_i + s c_j, c_j' = −s c_i + c c_j (Eq. A.2-A.4).
+        fn turn<const I: usize, const J: usize>(r: &mut Matrix3<f64>, s: f64, c: f64) {
+            let (a, b) = (r.fixed_columns::<1>(I).into_owned(), r.fixed_columns::<1>(J).into_owned());
+            r.fixed_columns_mut::<1>(I).copy_from(&(a * c + b * s));
+            r.fixed_columns_mut::<1>(J).copy_from(&(b * c - a * s));
+        }
         match self {
-            Axis::Frame(k) => {
-                // About axis k the columns i = k + 1 and j = k + 2 (cyclic) turn:
-                // c_i' = c c_i + s c_j, c_j' = −s c_i + c c_j (Eq. A.2-A.4).
-                let (i, j) = match k {
-                    0 => (1, 2),
-                    1 => (2, 0),
-                    _ => (0, 1),
-                };
-                for row in 0..3 {
-                    let (a, b) = (r[(row, i)], r[(row, j)]);
-                    r[(row, i)] = c * a + s * b;
-                    r[(row, j)] = c * b - s * a;
-                }
-            }
+            Axis::Frame(0) => turn::<1, 2>(r, s, c),
+            Axis::Frame(1) => turn::<2, 0>(r, s, c),
+            Axis::Frame(_) => turn::<0, 1>(r, s, c),
             Axis::General(e) => *r *= rotation_about_sin_cos(e, s, c),
         }
     }

@@ -208,20 +208,22 @@ fn free_gait_walks_on_five_legs_leg_2_failed() {
     assert_five_legs_walk(2);
 }
 
-// NOT MET on the full dynamic model with leg 0, 1, 4 or 5 failed (all six walk the whole 1.5 m
-// on the ideal plant, `control::gait::free::tests`). Measured: with leg 0, 1 or 5 failed the
-// walk halts for good after 0.28-0.31 m (a support leg at its boundary whose lift would leave
-// the body centre less than 2 cm inside the other feet; the other legs keep stepping in place,
-// 68-72 landings, all detected); with leg 4 failed the body leans towards the rear left corner
-// without a foot (5.2°) until the held-up foot touches the ground. Likely remedies, not done: a
-// body shift towards the remaining support polygon during such a deadlock instead of halting,
-// and holding a failed rear leg higher.
 #[test]
-#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_0_failed() {
     assert_five_legs_walk(0);
 }
 
+// NOT MET on the full dynamic model with leg 1, 4 or 5 failed (all six walk the whole 1.5 m on
+// the ideal plant, `control::gait::free::tests`). Leg 0 walks since the deadlock of a support
+// leg held back by the stability margin alone sways the body towards the other feet
+// (`FreeGaitController::sway`) and the deadlock fallback lifts only legs at their boundary.
+// Measured with these: leg 1 failed walks 1.03 m without a lasting deadlock but with 35
+// landings (the acceptance asks 40); with leg 4 or 5 failed the walk halts for good after
+// 0.28 m: the remaining rear leg reaches its rear boundary while the middle feet, at their
+// forward footholds, are still ahead of the body centre, and no sway that keeps that rear foot
+// in its workspace brings the centre 2 cm inside the four other feet (the held-up foot no
+// longer touches the ground since it is held at the top of its reach). Likely remedy, not
+// done: footholds of the middle legs set back with a rear leg failed, or an earlier rear step.
 #[test]
 #[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_1_failed() {

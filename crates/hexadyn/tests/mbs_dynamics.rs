@@ -111,3 +111,38 @@ fn free_fall() {
     assert_relative_eq!(nm.state().q[2], 1.0 - 0.5 * 9.81 * 0.16, epsilon = 1e-12);
     assert_eq!(nm.state().t, 0.4);
 }
+
+/// The mass matrix by composite rigid bodies on the AMRU5 (49 bodies, the pantograph's
+/// dependent parameters shared by several links, the rotors' spins) is the kinetic energy's
+/// Hessian in q̇, an independent oracle (T from the bodies' velocities, Eq. 3.26, 3.33):
+/// M_jk = T(e_j + e_k) − T(e_j) − T(e_k), M_jj = 2 T(e_j).
+#[test]
+fn amru5_mass_matrix_is_the_hessian_of_the_kinetic_energy() {
+    use hexadyn::description::RobotDescription;
+    use hexadyn::hexapod::{joint_index, Mechanics, MechanicsParameters, DOF};
+    let mech = Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap();
+    let model = &mech.model;
+    let mut q = [0.0; DOF];
+    q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
+    for leg in 0..6 {
+        q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
+        q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
+        q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
+    }
+    let (_, _, m) = energies(model, &q, &[0.0; DOF]);
+    let t = |j: usize, k: usize| {
+        let mut qd = [0.0; DOF];
+        qd[j] += 1.0;
+        qd[k] += 1.0;
+        energies(model, &q, &qd).0
+    };
+    let scale = m.amax();
+    for j in 0..DOF {
+        assert!((m[(j, j)] - 2.0 * t(j, j) / 4.0).abs() <= 1e-12 * scale, "M[{j},{j}]");
+        for k in 0..j {
+            let polarized = t(j, k) - t(j, j) / 4.0 - t(k, k) / 4.0;
+            assert!((m[(j, k)] - polarized).abs() <= 1e-12 * scale, "M[{j},{k}] = {} vs {polarized}", m[(j, k)]);
+            assert_eq!(m[(j, k)], m[(k, j)]);
+        }
+    }
+}

@@ -3,15 +3,18 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::dependent::{DependentValue, Jet};
-use super::model::{BodyId, Model};
-use crate::spatial::Htm;
+use super::model::{BodyId, CompiledElementary, Model};
+use crate::spatial::{Axis, Htm};
 
 /// Kinematic quantities of every body, their partial velocities and the applied wrenches of
 /// one evaluation. Create with [`Data::new`]; fill with [`super::kinematics`].
 #[derive(Clone, Debug)]
 pub struct Data {
-    /// T_{0,i} (Eq. 3.23).
+    /// T_{0,i} (Eq. 3.23), but for the turn of a spin about its axis (see `spin`).
     pub(crate) pose: Vec<Htm>,
+    /// For the bodies whose joint ends with a spin (see [`super::model::CompiledElementary`]):
+    /// its axis and angle at this evaluation, which [`Data::pose`] applies to `pose`.
+    pub(crate) spin: Vec<Option<(Axis, f64)>>,
     /// Central inertia tensors in the global frame, R Φ Rᵀ.
     pub(crate) world_inertia: Vec<Matrix3<f64>>,
     /// ω_i and v_i in the global frame (Eq. 3.26, 3.33).
@@ -59,6 +62,14 @@ impl Data {
         }
         Data {
             pose: vec![Htm::identity(); nb],
+            spin: model
+                .bodies
+                .iter()
+                .map(|b| match b.joint.last() {
+                    Some(CompiledElementary::Rotation { axis, angle: None, .. }) => Some((*axis, 0.0)),
+                    _ => None,
+                })
+                .collect(),
             world_inertia: vec![Matrix3::zeros(); nb],
             omega: vec![z; nb],
             velocity: vec![z; nb],
@@ -82,14 +93,18 @@ impl Data {
     }
 
     /// T_{0,i}: pose of the body's centre-of-gravity frame.
-    pub fn pose(&self, b: BodyId) -> &Htm {
-        &self.pose[b.0]
+    pub fn pose(&self, b: BodyId) -> Htm {
+        let mut pose = self.pose[b.0];
+        if let Some((axis, angle)) = self.spin[b.0] {
+            axis.rotate(&mut pose.rotation, angle.sin_cos());
+        }
+        pose
     }
     pub fn position(&self, b: BodyId) -> Vector3<f64> {
         self.pose[b.0].translation
     }
-    pub fn rotation(&self, b: BodyId) -> &Matrix3<f64> {
-        &self.pose[b.0].rotation
+    pub fn rotation(&self, b: BodyId) -> Matrix3<f64> {
+        self.pose(b).rotation
     }
     pub fn velocity(&self, b: BodyId) -> Vector3<f64> {
         self.velocity[b.0]
@@ -103,7 +118,7 @@ impl Data {
     }
     /// Global position of a point given in the body frame.
     pub fn point(&self, b: BodyId, local: &Vector3<f64>) -> Vector3<f64> {
-        self.pose[b.0].apply(local)
+        self.pose(b).apply(local)
     }
     /// Velocity of a material point of body b at global position `p`.
     pub fn point_velocity(&self, b: BodyId, p: &Vector3<f64>) -> Vector3<f64> {

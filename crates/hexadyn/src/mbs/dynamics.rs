@@ -1,7 +1,7 @@
 //! Equations of motion by the virtual power principle (thesis Eq. 3.37-3.41):
 //! M(q) q̈ + h(q, q̇) = g(q, q̇, t).
 
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::data::Data;
 use super::model::Model;
@@ -55,32 +55,87 @@ pub fn residual(model: &Model, data: &mut Data, qdd: &[f64], f: &mut [f64]) {
     }
 }
 
-/// Mass matrix M(q) (Eq. 3.39) into the top-left n × n block of `m` (overwritten). Needs the
-/// partial velocities ([`super::kinematics`], or [`super::partial_velocities`] after
-/// [`super::relative_kinematics`]).
+/// Mass and inertia of a body and its descendants about the body's centre of gravity G_b,
+/// global frame: mass m, first moment h = Σ m_i (p_i − p_b) and inertia tensor
+/// I = Σ Φ_i + m_i (|s_i|² E − s_i s_iᵀ), s_i = p_i − p_b (a composite rigid body).
+#[derive(Clone, Copy, Debug)]
+struct Composite {
+    mass: f64,
+    first_moment: Vector3<f64>,
+    inertia: Matrix3<f64>,
+}
+
+impl Composite {
+    /// Adds `c`, given about a point at `r` from G_b (parallel axes: s = r + s_c).
+    fn add(&mut self, c: &Composite, r: &Vector3<f64>) {
+        let h = c.first_moment;
+        let shift = Matrix3::from_diagonal_element(c.mass * r.norm_squared() + 2.0 * r.dot(&h)) - (r * r.transpose()) * c.mass - r * h.transpose() - h * r.transpose();
+        self.inertia += c.inertia + shift;
+        self.first_moment += h + r * c.mass;
+        self.mass += c.mass;
+    }
+
+    /// Momentum (linear L, angular H about G_b) of the composite moving rigidly with velocity
+    /// v at G_b and angular velocity ω: L = m v + ω × h, H = h × v + I ω.
+    fn momentum(&self, v: &Vector3<f64>, omega: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        (v * self.mass + omega.cross(&self.first_moment), self.first_moment.cross(v) + self.inertia * omega)
+    }
+}
+
+/// Mass matrix M(q) (Eq. 3.39) into the top-left n × n block of `m` (overwritten). Needs
+/// [`super::relative_kinematics`]. As d_ij, δ_ij sum the relative partial velocities of the
+/// joints a on the path to body i carried rigidly to G_i (see [`residual`]),
+/// M_jk = Σ_i m_i d_ij·d_ik + δ_ij·Φ_i δ_ik = Σ_(a, b) d^rel_aj·L_bk + δ^rel_aj·(H_bk + (p_b − p_a) × L_bk)
+/// over the bodies b and their ancestors a (b included), (L_bk, H_bk) the momentum at G_b of
+/// body b and its descendants moved rigidly by the relative partial velocity of column k of
+/// b's joint (composite rigid bodies, the CRBA of Featherstone's Rigid Body Dynamics
+/// Algorithms, Section 6.2, on the relative partial velocities).
 pub fn mass_matrix(model: &Model, data: &Data, m: &mut DMatrix<f64>) {
-    data.assert_complete();
     let n = model.coordinates;
-    m.view_mut((0, 0), (n, n)).fill(0.0);
-    for (i, body) in model.bodies.iter().enumerate() {
-        let cols = &body.columns;
-        let d = &data.d[body.offset..body.offset + cols.len()];
-        let delta = &data.delta[body.offset..body.offset + cols.len()];
-        let phi = data.world_inertia[i];
-        for (k, &ck) in cols.iter().enumerate() {
-            let md = d[k] * body.mass;
-            let pd = phi * delta[k];
-            for (l, &cl) in cols.iter().enumerate().skip(k) {
-                m[(ck, cl)] += md.dot(&d[l]) + pd.dot(&delta[l]);
+    let rows = m.nrows();
+    for column in m.as_mut_slice().chunks_mut(rows).take(n) {
+        column[..n].fill(0.0);
+    }
+    let mut composite: Vec<Composite> = model.bodies.iter().enumerate().map(|(i, b)| Composite { mass: b.mass, first_moment: Vector3::zeros(), inertia: data.world_inertia[i] }).collect();
+    // Descendants first (a body comes after its reference body).
+    for (i, body) in model.bodies.iter().enumerate().rev() {
+        if let Some(p) = body.parent {
+            let c = composite[i];
+            composite[p].add(&c, &(data.pose[i].translation - data.pose[p].translation));
+        }
+    }
+    for (b, body) in model.bodies.iter().enumerate() {
+        let own = |a: &super::model::Body, j: usize| (data.d_rel[a.own_offset + j], data.delta_rel[a.own_offset + j]);
+        for (k, &ck) in body.own.iter().enumerate() {
+            let (d, delta) = own(body, k);
+            let (linear, mut angular) = composite[b].momentum(&d, &delta);
+            // a = b: M is symmetric, the pairs j ≥ k give both triangles.
+            for (j, &cj) in body.own.iter().enumerate().skip(k) {
+                let (dj, deltaj) = own(body, j);
+                let x = dj.dot(&linear) + deltaj.dot(&angular);
+                m[(cj, ck)] += x;
+                if j != k {
+                    m[(ck, cj)] += x;
+                }
+            }
+            // The strict ancestors a of b, each pair once in both triangles (twice on the
+            // diagonal when a and b share the column: the cross term of (x + y)ᵀ I (x + y)).
+            let (mut a, mut at) = (body.parent, data.pose[b].translation);
+            while let Some(ai) = a {
+                let ancestor = &model.bodies[ai];
+                let pa = data.pose[ai].translation;
+                angular += (at - pa).cross(&linear);
+                at = pa;
+                for (j, &cj) in ancestor.own.iter().enumerate() {
+                    let (dj, deltaj) = own(ancestor, j);
+                    let x = dj.dot(&linear) + deltaj.dot(&angular);
+                    m[(cj, ck)] += x;
+                    m[(ck, cj)] += x;
+                }
+                a = ancestor.parent;
             }
         }
     }
-    for r in 0..n {
-        for c in 0..r {
-            m[(r, c)] = m[(c, r)];
-        }
-    }
-    // Columns were visited in sorted order, so (ck <= cl) and the upper triangle is complete.
 }
 
 /// Centrifugal and Coriolis contribution h(q, q̇) (Eq. 3.40).

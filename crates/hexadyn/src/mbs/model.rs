@@ -144,8 +144,9 @@ pub(crate) enum CompiledElementary {
     /// A constant displacement T^d (Eq. A.1).
     Offset(Vector3<f64>),
     /// `angle`: index of the variable in [`Model::angles`], whose sine and cosine are
-    /// evaluated once per kinematics.
-    Rotation { axis: Axis, var: CompiledVar, angle: usize },
+    /// evaluated once per kinematics; `None` for a spin (see [`spins_freely`]): the rotation's
+    /// ω, α and δ are carried, the turn of R about the axis is left to [`super::Data::pose`].
+    Rotation { axis: Axis, var: CompiledVar, angle: Option<usize> },
     Translation { axis: Axis, var: CompiledVar },
 }
 
@@ -218,6 +219,20 @@ impl Model {
 
 /// Standard gravity g (m/s²): the default gravity of a [`Model`], along −z.
 pub const STANDARD_GRAVITY: f64 = 9.81;
+
+/// Whether the last elementary of the body's joint is a spin: a rotation about a frame axis of
+/// a body that is no reference body and whose central inertia is symmetric about that axis
+/// (the two other principal moments equal, e.g. a rotor turning at n q, Eq. 3.69-3.71). Its
+/// angle then enters no dynamic quantity: R R_e(θ) Φ R_e(θ)ᵀ Rᵀ = R Φ Rᵀ, the centre of
+/// gravity stays on the axis, ω, α and the partial velocities do not depend on θ, and no other
+/// body is placed from it. Any other body turns in full (the fallback).
+fn spins_freely(spec: &BodySpec, is_parent: bool) -> bool {
+    let Some(Elementary::Rotation { axis, .. }) = spec.joint.last() else { return false };
+    let Axis::Frame(k) = Axis::of(axis) else { return false };
+    let phi = &spec.inertia;
+    let principal = *phi == Matrix3::from_diagonal(&phi.diagonal());
+    !is_parent && principal && phi[((k + 1) % 3, (k + 1) % 3)] == phi[((k + 2) % 3, (k + 2) % 3)]
+}
 
 /// Builds a [`Model`] body after body.
 #[derive(Debug)]
@@ -303,7 +318,9 @@ impl ModelBuilder {
         let mut bodies: Vec<Body> = Vec::with_capacity(self.specs.len());
         let (mut offset, mut own_offset) = (0, 0);
         let mut angles: Vec<Var> = Vec::new();
-        for spec in &self.specs {
+        let is_parent: Vec<bool> = (0..self.specs.len()).map(|id| self.specs.iter().any(|s| s.parent == Some(BodyId(id)))).collect();
+        for (id, spec) in self.specs.iter().enumerate() {
+            let spin = spins_freely(spec, is_parent[id]);
             let mut own: Vec<usize> = Vec::new();
             for e in &spec.joint {
                 if let Elementary::Rotation { var, .. } | Elementary::Translation { var, .. } = e {
@@ -323,14 +340,16 @@ impl ModelBuilder {
             let compile = |var: &Var| CompiledVar { var: *var, columns: self.source_inputs(var.source).into_iter().map(own_pos).collect() };
             // Consecutive constant HTMs are multiplied once here rather than at every evaluation.
             let mut joint: Vec<CompiledElementary> = Vec::with_capacity(spec.joint.len());
-            for e in &spec.joint {
+            for (k, e) in spec.joint.iter().enumerate() {
                 match (e, joint.last_mut()) {
                     (Elementary::Fixed(h), Some(CompiledElementary::Fixed(previous))) => *previous = previous.compose(h),
                     (Elementary::Fixed(h), _) => joint.push(CompiledElementary::Fixed(*h)),
                     (Elementary::Rotation { axis, var }, _) => {
-                        let angle = angles.iter().position(|a| a == var).unwrap_or_else(|| {
-                            angles.push(*var);
-                            angles.len() - 1
+                        let angle = (!(spin && k + 1 == spec.joint.len())).then(|| {
+                            angles.iter().position(|a| a == var).unwrap_or_else(|| {
+                                angles.push(*var);
+                                angles.len() - 1
+                            })
                         });
                         joint.push(CompiledElementary::Rotation { axis: Axis::of(axis), var: compile(var), angle })
                     }

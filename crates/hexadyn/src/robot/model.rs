@@ -573,12 +573,14 @@ impl System for Robot {
             }
             let df_dq = c.df_dp * j_foot + c.df_dv * &inertial.dv_dq[leg];
             let df_dqd = c.df_dv * j_foot;
-            let kt = -j_foot.transpose() * df_dq;
-            let ct = -j_foot.transpose() * df_dqd;
-            let mut block = jac.kt.view_mut((0, 0), (DOF, DOF));
-            block += kt;
-            let mut block = jac.ct.view_mut((0, 0), (DOF, DOF));
-            block += ct;
+            // −J_footᵀ ∂F/∂q and −J_footᵀ ∂F/∂q', over the rows of the foot's columns only (the
+            // body's and its leg's: J_foot is zero elsewhere).
+            for (row, d) in self.data.point_partial_velocities(&mech.model, bodies.links[3], &self.outputs.foot[leg]) {
+                for col in 0..DOF {
+                    jac.kt[(row, col)] -= d.dot(&df_dq.column(col));
+                    jac.ct[(row, col)] -= d.dot(&df_dqd.column(col));
+                }
+            }
             // The normal force (the leg load of Eq. 5.12): F_n = n·F.
             let normal = m.terrain.height_normal(self.outputs.foot[leg].x, self.outputs.foot[leg].y).1;
             dfn_dq[leg] = normal.transpose() * df_dq;

@@ -139,6 +139,8 @@ pub struct FreeGaitController {
     walk: Walk<Leg>,
     /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
     posture: (Vector3<f64>, f64),
+    /// The body sway of a deadlock on five legs ([`Self::sway`]): global velocity (m/s).
+    sway: Option<(usize, Vector3<f64>)>,
     state: FreeGaitState,
     pub diagnostics: GaitDiagnostics,
 }
@@ -169,6 +171,7 @@ impl FreeGaitController {
             reach_top,
             walk: Walk { body: None, legs: [idle; 6] },
             posture: (z, f64::NEG_INFINITY),
+            sway: None,
             state: FreeGaitState::default(),
             diagnostics: GaitDiagnostics::default(),
         }
@@ -191,11 +194,29 @@ impl FreeGaitController {
         body.compose(&self.legs_kinematics[leg].body_from_leg())
     }
 
-    /// Where a failed leg is held: its workspace centre at the top of the workspace, the height
-    /// of a foot in the air.
+    /// Where a failed leg is held: above its workspace centre, as high as the leg reaches there
+    /// less the security margin of the working volume ([`AEP_SECURITY`]).
+    ///
+    /// INTERPRETATION (beyond the thesis): "held up" is read as high as the leg can be held. At
+    /// the top of the workspace, the height of a foot in the air (one lift above the ground),
+    /// the held-up foot of a failed rear leg touched the ground when the body leaned 5.2°
+    /// towards its corner while a neighbour swung (measured with leg 4 failed): a failed leg
+    /// carries no weight and needs no room to step, so nothing keeps it as low as a swinging
+    /// foot. The highest reachable point above the centre is found by bisection on the
+    /// reachable radii of the pantograph ([`LegKinematics::radii_at`]), which shrink upwards.
     fn held_up(&self, leg: usize) -> Vector3<f64> {
-        let w = &self.workspaces[leg];
-        w.centre_at(w.z_max)
+        let (w, kin) = (&self.workspaces[leg], &self.legs_kinematics[leg]);
+        let rho = w.centre.norm();
+        let reaches = |z: f64| kin.radii_at(z).is_some_and(|(lo, hi)| lo <= rho && rho <= hi);
+        let (mut low, mut high) = (w.z_max, self.reach_top[leg]);
+        if reaches(high) {
+            low = high;
+        }
+        while high - low > 1e-6 {
+            let mid = 0.5 * (low + high);
+            if reaches(mid) { low = mid } else { high = mid }
+        }
+        w.centre_at((low - AEP_SECURITY).max(w.z_max))
     }
 
     /// First update: the body pose (navigation, or level with the body frame at the mean foot
@@ -282,19 +303,83 @@ impl FreeGaitController {
     /// margins, the tie-break makes it the only candidate, and the robot would stay halted for
     /// good (legs 0, 1 and 2 failed). Lifting another leg that Rule 2 allows is the smallest
     /// change that lets the walk go on: Rule 3 orders the legs, the stability decides.
+    ///
+    /// INTERPRETATION: the fallback lifts only a leg at its boundary (or the leg the body sways
+    /// for, [`Self::sway`]). A leg far from its boundary that just landed at its AEP gains nothing
+    /// by stepping again during a deadlock, since the body stands still, and holds its neighbours
+    /// back under Rule 2: with leg 0 failed, legs 3 and 4 stepped in place for good while legs
+    /// 1, 2 and 5 stood at their boundaries (measured). The deadlock also lasts while the body
+    /// sways for a blocked leg, until that leg lifts.
     fn lifting(&self, candidates: [bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
+        let swaying = self.sway.map(|(b, _)| b);
         if self.options.failed_leg.is_none() {
             return candidates;
         }
         let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
         let lifting = self.stable_lifts(candidates, margins, &support, estimated);
-        if !deadlocked(&support, margins, &lifting, boundary) {
+        if !deadlocked(&support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
             return lifting;
         }
-        let rule_2: [bool; 6] = std::array::from_fn(|l| support[l] && self.neighbours[l].is_some_and(|(a, b)| support[a] && support[b]));
-        let fallback = self.stable_lifts(rule_2, margins, &support, estimated);
+        let at_boundary: [bool; 6] = std::array::from_fn(|l| self.rule_2(l, &support) && (margins[l] < boundary || swaying == Some(l)));
+        let fallback = self.stable_lifts(at_boundary, margins, &support, estimated);
         let first = (0..6).filter(|&l| fallback[l]).min_by(|&a, &b| margins[a].total_cmp(&margins[b]));
         std::array::from_fn(|l| Some(l) == first)
+    }
+
+    /// Rule 2: leg `l` is in support and so are its two neighbours.
+    fn rule_2(&self, l: usize, support: &[bool; 6]) -> bool {
+        support[l] && self.neighbours[l].is_some_and(|(a, b)| support[a] && support[b])
+    }
+
+    /// Beyond the thesis, the deadlock of Section 7.7.4 on five legs: the body velocity (global,
+    /// horizontal) that sways the body towards the feet that would stay in support if the
+    /// blocked leg lifted, `None` to halt as in the thesis.
+    ///
+    /// INTERPRETATION: on six legs a deadlock clears when the neighbour in the air lands (Rule
+    /// 2), and halting is "the safest way to operate". On five legs a support leg at its
+    /// boundary that Rule 2 allows can be held back by the stability margin alone; halting then
+    /// changes nothing, since the body and the feet in support stand still, and the walk halted
+    /// for good (measured with leg 0, 1 or 5 failed). The blocked leg is the one of lowest margin
+    /// (the lower leg number on a tie, as in Rule 3) among the support legs at their boundary
+    /// that Rule 2 allows and that do not lift. The body moves at the commanded walking speed
+    /// towards the centroid of the feet left in support without it (the body sway of the
+    /// quadruped crawl gaits, the usual remedy on a hexapod with a failed leg), until the lift
+    /// keeps the stability margin and the leg lifts (Rule 3, [`Self::lifting`]). The feet at
+    /// their boundary do not move outwards: the component of the sway that would push one out is
+    /// removed, so they slide along the boundary or move inwards; if the sway would take another
+    /// support foot out of its workspace, or leaves no motion, or fewer than three feet would
+    /// stay down, the body halts as in the thesis.
+    #[allow(clippy::too_many_arguments)]
+    fn sway(&self, swaying: Option<usize>, support: &[bool; 6], lifting: &[bool; 6], margins: &[f64; 6], boundary: f64, estimated: &Htm, desired: &Htm, speed: f64) -> Option<(usize, Vector3<f64>)> {
+        self.options.failed_leg?;
+        let standing: [bool; 6] = std::array::from_fn(|l| support[l] && !lifting[l]);
+        let blocked = swaying.filter(|&b| self.rule_2(b, support)).or_else(|| (0..6).filter(|&l| standing[l] && margins[l] < boundary && self.rule_2(l, support)).min_by(|&a, &b| margins[a].total_cmp(&margins[b]).then(a.cmp(&b))))?;
+        let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| standing[k] && k != blocked).map(|k| self.walk.legs[k].anchor.xy()).collect();
+        let towards = feet.iter().sum::<Vector2<f64>>() / feet.len() as f64 - estimated.translation.xy();
+        if feet.len() < 3 || !(speed > 0.0) || !(towards.norm() > 0.0) {
+            return None;
+        }
+        let towards = towards.normalize() * speed;
+        let mut u = Vector3::new(towards.x, towards.y, 0.0);
+        // The outward normal (global, horizontal) of each foot at its boundary.
+        let outward = |k: usize| {
+            let out = self.walk.legs[k].foot.xy() - self.workspaces[k].centre;
+            let n = self.leg_frame(k, desired).rotation * Vector3::new(out.x, out.y, 0.0);
+            Vector3::new(n.x, n.y, 0.0).normalize()
+        };
+        let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary).collect();
+        for &k in &at_boundary {
+            let n = outward(k);
+            u -= n * u.dot(&n).min(0.0);
+        }
+        // The foot moves by −u dt relative to its leg frame.
+        let stays = |k: usize| {
+            let p = self.walk.legs[k].foot - self.leg_frame(k, desired).rotation.transpose() * u * self.options.dt;
+            (p.xy() - self.workspaces[k].centre).norm() <= self.workspaces[k].radius
+        };
+        let outwards = at_boundary.iter().any(|&k| u.dot(&outward(k)) < -1e-9 * speed);
+        let leaves = (0..6).any(|k| standing[k] && margins[k] >= boundary && !stays(k));
+        (u.norm() > 1e-3 * speed && !outwards && !leaves).then_some((blocked, u))
     }
 
     /// Among `candidates`, in order of increasing margin, the legs whose lift leaves the body
@@ -374,7 +459,7 @@ impl Controller for FreeGaitController {
         let rotation = before.htm().rotation;
         let landing_speed = o.lift / o.takeoff_time;
         let (mut v_b, omega_b) = if self.state.deadlock {
-            (Vector3::zeros(), Vector3::zeros())
+            (self.sway.map_or_else(Vector3::zeros, |(_, u)| u), Vector3::zeros())
         } else {
             let (local, until) = self.posture;
             let local = if m.t < until - 0.5 * o.dt { local } else { Vector3::zeros() };
@@ -517,7 +602,9 @@ impl Controller for FreeGaitController {
             let leg = &mut self.walk.legs[l];
             (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);
         }
-        self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary);
+        let swaying = self.sway.map(|(b, _)| b).filter(|&b| support[b] && !lifting[b]);
+        self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary) || swaying.is_some();
+        self.sway = if self.state.deadlock { self.sway(swaying, &support, &lifting, &margins, boundary, &estimated, &desired, h.velocity.xy().norm()) } else { None };
         self.state.deadlocked_periods += usize::from(self.state.deadlock);
         self.state.reaching_down = reaching_down && room > REACH_ROOM;
 
