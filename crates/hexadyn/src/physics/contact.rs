@@ -86,7 +86,13 @@ impl GroundContact {
     /// dδ/dt ≠ 0. The friction is Coulomb with a linear zone (Eq. 3.73) on the tangential slip
     /// velocity v_g = v - (n · v) n.
     pub fn force<T: Terrain + ?Sized>(&self, p: &Vector3<f64>, v: &Vector3<f64>, terrain: &T) -> ContactForce {
-        let Proximity { penetration: delta, normal: n } = terrain.proximity(p, self.foot_radius);
+        self.force_at(terrain.proximity(p, self.foot_radius), v)
+    }
+
+    /// The contact force of [`Self::force`] on a foot moving at `v` whose contact geometry with
+    /// the ground (for a foot sphere of radius [`Self::foot_radius`]) is `proximity`.
+    pub fn force_at(&self, proximity: Proximity, v: &Vector3<f64>) -> ContactForce {
+        let Proximity { penetration: delta, normal: n } = proximity;
         let delta_rate = -n.dot(v);
         let projector = Matrix3::identity() - n * n.transpose();
         let slip = projector * v;

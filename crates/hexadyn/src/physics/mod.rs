@@ -12,7 +12,7 @@ mod motor;
 pub mod terrain;
 
 pub use contact::{ContactForce, GroundContact};
-pub use terrain::{Extent, FlatGround, Heightfield, MeshTerrain, Proximity, Slope, Step, Terrain, Triangles};
+pub use terrain::{Extent, FlatGround, Heightfield, MeshTerrain, Proximity, Slope, Step, Terrain, Triangles, Vicinity};
 pub use current_sensor::{AnalogLowPass, CurrentSensing, CurrentSensors, ANALOG_CURRENT_CUTOFF_HZ};
 pub use friction::{
     BristleResidual, DryViscous, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,

@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, Vector3};
 use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
-use crate::physics::{ContactForce, GroundContact, Terrain};
+use crate::physics::{ContactForce, GroundContact, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
@@ -305,6 +305,8 @@ pub struct Robot {
     pub outputs: Outputs,
     /// The slowly varying part of the Jacobian (see [`Robot::jacobian`]) and where it was taken.
     inertial: Option<InertialJacobian>,
+    /// The ground near each foot, kept between the contact queries of the evaluations.
+    vicinity: [Vicinity; 6],
 }
 
 /// ∂/∂q and ∂/∂q' of the multibody rows with the contact forces and joint forces held at their
@@ -337,7 +339,7 @@ impl InertialJacobian {
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
-        Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None }
+        Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None, vicinity: Default::default() }
     }
 
     /// The multibody workspace: kinematics and applied forces of the last evaluation.
@@ -440,7 +442,8 @@ impl Robot {
         for (leg, bodies) in mech.legs.iter().enumerate() {
             let p = self.data.point(bodies.links[3], &mech.foot_local);
             let v = self.data.point_velocity(bodies.links[3], &p);
-            let mut c = m.options.ground.force(&p, &v, m.terrain.as_ref());
+            let proximity = m.terrain.proximity_near(&p, m.options.ground.foot_radius, &mut self.vicinity[leg]);
+            let mut c = m.options.ground.force_at(proximity, &v);
             // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v.
             c.force.z += m.options.foot_load[leg];
             c.normal_force += m.options.foot_load[leg];

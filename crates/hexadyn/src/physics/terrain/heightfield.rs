@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 
-use super::{Extent, MeshError, MeshTerrain, Proximity, Terrain, Triangles};
+use super::{Extent, MeshError, MeshTerrain, Proximity, Terrain, Triangles, Vicinity};
 
 /// Heights z_ij at (x_0 + i Δ, y_0 + j Δ), i = 0..n_x, j = 0..n_y, each cell cut into two
 /// triangles along its diagonal from (i, j) to (i + 1, j + 1): the surface is continuous and
@@ -96,6 +96,10 @@ impl Terrain for Heightfield {
 
     fn proximity(&self, p: &Vector3<f64>, radius: f64) -> Proximity {
         self.mesh.proximity(p, radius)
+    }
+
+    fn proximity_near(&self, p: &Vector3<f64>, radius: f64, vicinity: &mut Vicinity) -> Proximity {
+        self.mesh.proximity_near(p, radius, vicinity)
     }
 
     fn triangles(&self, extent: Extent) -> Triangles {

@@ -30,7 +30,7 @@ pub mod generate;
 pub mod ply;
 
 pub use heightfield::Heightfield;
-pub use mesh::{MeshError, MeshTerrain};
+pub use mesh::{MeshError, MeshTerrain, Vicinity};
 pub use step::Step;
 
 use nalgebra::Vector3;
@@ -71,6 +71,14 @@ pub trait Terrain: std::fmt::Debug + Send + Sync {
 
     /// Closest-point contact of a foot sphere of `radius` centred at `p` (module docs).
     fn proximity(&self, p: &Vector3<f64>, radius: f64) -> Proximity;
+
+    /// The same contact as [`Terrain::proximity`], for a foot that keeps its [`Vicinity`] from
+    /// one query to the next: a terrain that searches for the closest point (a mesh) looks
+    /// first among the faces it found near the foot's last position. The answer does not depend
+    /// on the vicinity (only its cost does); the analytic terrains ignore it.
+    fn proximity_near(&self, p: &Vector3<f64>, radius: f64, _vicinity: &mut Vicinity) -> Proximity {
+        self.proximity(p, radius)
+    }
 
     /// The surface as triangles: a mesh's own; an analytic terrain's within `extent`.
     fn triangles(&self, extent: Extent) -> Triangles;

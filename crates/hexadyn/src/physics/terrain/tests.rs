@@ -109,6 +109,38 @@ fn mesh_proximity_matches_brute_force_on_ten_thousand_queries() {
 }
 
 #[test]
+fn a_foot_vicinity_gives_the_whole_mesh_answer() {
+    // Feet wandering over a random heightfield and around a block with vertical faces, in
+    // steps from a micrometre (a foot on the ground) to 5 cm (a swing, a reset), each keeping
+    // its vicinity: the contact must be that of the search over the whole mesh, bit for bit.
+    let field = random_heightfield(33, 30, 0.1);
+    let block = MeshTerrain::new(generate::step_block(0.08)).unwrap();
+    let mut r = rng(34);
+    let mut gathered = 0;
+    for (terrain, y_range) in [(&field as &dyn Terrain, 0.8f64..2.2), (&block, -0.4..0.2)] {
+        let mut vicinity = Vicinity::default();
+        let mut p = Vector3::<f64>::new(1.5, y_range.start, 0.0);
+        for k in 0..20_000 {
+            let step = [1e-6, 1e-6, 1e-4, 3e-3, 5e-2][r.random_range(0..5)];
+            p += step * Vector3::new(r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), r.random_range(-1.0..1.0));
+            // Kept over the middle of the terrain, from 1 cm below its surface to 8 cm above.
+            p.x = p.x.clamp(0.8, 2.2);
+            p.y = p.y.clamp(y_range.start, y_range.end);
+            let h = terrain.height_normal(p.x, p.y).0;
+            p.z = p.z.clamp(h - 0.01, h + 0.08);
+            let radius = if k % 3 == 0 { 0.02 } else { 0.0 };
+            let before = vicinity.reach;
+            let got = terrain.proximity_near(&p, radius, &mut vicinity);
+            gathered += usize::from(vicinity.reach != before);
+            let want = terrain.proximity(&p, radius);
+            assert_eq!(got, want, "query {k} at {p:?}");
+        }
+    }
+    // Both the vicinity and the whole-mesh search answered (the test exercises both paths).
+    assert!(gathered > 100 && gathered < 30_000, "{gathered} of 40 000 queries gathered a new vicinity");
+}
+
+#[test]
 fn sliding_across_a_tiled_plane_feels_no_edge() {
     // The plane z = 0.1 + 0.2 x - 0.1 y tiled by 2 x 22 x 22 = 968 triangles.
     let slope = Slope { height: 0.1, slope_x: 0.2, slope_y: -0.1 };
