@@ -575,7 +575,7 @@ impl System for Robot {
             let df_dqd = c.df_dv * j_foot;
             // −J_footᵀ ∂F/∂q and −J_footᵀ ∂F/∂q', over the rows of the foot's columns only (the
             // body's and its leg's: J_foot is zero elsewhere).
-            for (row, d) in self.data.point_partial_velocities(&mech.model, bodies.links[3], &self.outputs.foot[leg]) {
+            for (row, d) in j_foot.column_iter().enumerate().filter(|(_, d)| *d != Vector3::zeros()) {
                 for col in 0..DOF {
                     jac.kt[(row, col)] -= d.dot(&df_dq.column(col));
                     jac.ct[(row, col)] -= d.dot(&df_dqd.column(col));

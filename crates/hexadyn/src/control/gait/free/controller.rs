@@ -16,7 +16,7 @@ use super::elevator::{resistance, retreat, ELEVATOR_FORCE};
 use super::landing::SETTLING_TIME_CONSTANTS;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture, PostureCorrection};
-use super::rules::{deadlocked, neighbours, stability_margin, swing_candidates};
+use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};
 use super::velocity::corrected_velocities;
 use crate::control::gait::body_motion::{BodyMotion, Pose};
 use crate::control::gait::walk::{LegState, Walk};
@@ -310,25 +310,19 @@ impl FreeGaitController {
     /// back under Rule 2: with leg 0 failed, legs 3 and 4 stepped in place for good while legs
     /// 1, 2 and 5 stood at their boundaries (measured). The deadlock also lasts while the body
     /// sways for a blocked leg, until that leg lifts.
-    fn lifting(&self, candidates: [bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
+    fn lifting(&self, candidates: [bool; 6], support: &[bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
         let swaying = self.sway.map(|(b, _)| b);
         if self.options.failed_leg.is_none() {
             return candidates;
         }
-        let support: [bool; 6] = std::array::from_fn(|l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support);
-        let lifting = self.stable_lifts(candidates, margins, &support, estimated);
-        if !deadlocked(&support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
+        let lifting = self.stable_lifts(candidates, margins, support, estimated);
+        if !deadlocked(support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
             return lifting;
         }
-        let at_boundary: [bool; 6] = std::array::from_fn(|l| self.rule_2(l, &support) && (margins[l] < boundary || swaying == Some(l)));
-        let fallback = self.stable_lifts(at_boundary, margins, &support, estimated);
+        let at_boundary: [bool; 6] = std::array::from_fn(|l| rule_2(l, support, &self.neighbours) && (margins[l] < boundary || swaying == Some(l)));
+        let fallback = self.stable_lifts(at_boundary, margins, support, estimated);
         let first = (0..6).filter(|&l| fallback[l]).min_by(|&a, &b| margins[a].total_cmp(&margins[b]));
         std::array::from_fn(|l| Some(l) == first)
-    }
-
-    /// Rule 2: leg `l` is in support and so are its two neighbours.
-    fn rule_2(&self, l: usize, support: &[bool; 6]) -> bool {
-        support[l] && self.neighbours[l].is_some_and(|(a, b)| support[a] && support[b])
     }
 
     /// Beyond the thesis, the deadlock of Section 7.7.4 on five legs: the body velocity (global,
@@ -353,7 +347,7 @@ impl FreeGaitController {
     fn sway(&self, swaying: Option<usize>, support: &[bool; 6], lifting: &[bool; 6], margins: &[f64; 6], boundary: f64, estimated: &Htm, desired: &Htm, speed: f64) -> Option<(usize, Vector3<f64>)> {
         self.options.failed_leg?;
         let standing: [bool; 6] = std::array::from_fn(|l| support[l] && !lifting[l]);
-        let blocked = swaying.filter(|&b| self.rule_2(b, support)).or_else(|| (0..6).filter(|&l| standing[l] && margins[l] < boundary && self.rule_2(l, support)).min_by(|&a, &b| margins[a].total_cmp(&margins[b]).then(a.cmp(&b))))?;
+        let blocked = swaying.filter(|&b| rule_2(b, support, &self.neighbours)).or_else(|| (0..6).filter(|&l| standing[l] && margins[l] < boundary && rule_2(l, support, &self.neighbours)).min_by(|&a, &b| margins[a].total_cmp(&margins[b]).then(a.cmp(&b))))?;
         let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| standing[k] && k != blocked).map(|k| self.walk.legs[k].anchor.xy()).collect();
         let towards = feet.iter().sum::<Vector2<f64>>() / feet.len() as f64 - estimated.translation.xy();
         if feet.len() < 3 || !(speed > 0.0) || !(towards.norm() > 0.0) {
@@ -597,7 +591,7 @@ impl Controller for FreeGaitController {
         // A neighbour's step: takeoff, swing and a landing as long as the takeoff on flat ground.
         let reserve = speed_max * (2.0 * o.takeoff_time + o.swing_time);
         let boundary = speed_max * o.dt;
-        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours, reserve), &margins, &estimated, boundary);
+        let lifting = self.lifting(swing_candidates(&support, &margins, &self.neighbours, reserve), &support, &margins, &estimated, boundary);
         for l in (0..6).filter(|&l| lifting[l]) {
             let leg = &mut self.walk.legs[l];
             (leg.phase, leg.elapsed, leg.contact) = (FootPhase::Takeoff, 0.0, leg.anchor);

@@ -24,6 +24,12 @@ pub fn neighbours(failed: Option<usize>) -> [Option<(usize, usize)>; 6] {
     table
 }
 
+/// Rule 2: leg `l` may swing only if it is a working leg in support and so are its two
+/// neighbours.
+pub fn rule_2(l: usize, support: &[bool; 6], neighbours: &[Option<(usize, usize)>; 6]) -> bool {
+    support[l] && neighbours[l].is_some_and(|(a, b)| support[a] && support[b])
+}
+
 /// The legs that start their swing now (Rules 2 and 3 with the priority of [PORT04]).
 /// `support[l]`: leg l is in its support phase; `margin[l]`: its kinematic margin (m) along the
 /// foot's motion in the leg frame; `reserve` (m): the distance a foot travels in support while a
@@ -72,7 +78,7 @@ pub fn neighbours(failed: Option<usize>) -> [Option<(usize, usize)>; 6] {
 pub fn swing_candidates(support: &[bool; 6], margin: &[f64; 6], neighbours: &[Option<(usize, usize)>; 6], reserve: f64) -> [bool; 6] {
     let of = |l: usize| neighbours[l].map_or([l, l], |(a, b)| [a, b]);
     // Rule 2.
-    let rule_2: [bool; 6] = std::array::from_fn(|l| neighbours[l].is_some() && support[l] && margin[l].is_finite() && of(l).iter().all(|&n| support[n]));
+    let rule_2: [bool; 6] = std::array::from_fn(|l| rule_2(l, support, neighbours) && margin[l].is_finite());
     // The priority: the lower margin, then the lower leg number.
     let order = |a: &usize, b: &usize| margin[*a].total_cmp(&margin[*b]).then(a.cmp(b));
     let before = |a: usize, b: usize| order(&a, &b).is_lt();
