@@ -107,6 +107,39 @@ fn analytic_jacobian_matches_finite_differences() {
     }
 }
 
+/// The mass matrix of the multibody rows in the Jacobian (Eq. 3.39) is kept with the inertial
+/// terms while the configuration moves little and re-taken beyond (0.2 rad on a q_r): 0.05 rad
+/// later it is still the one of the first configuration, 0.3 rad later the exact one again.
+#[test]
+fn jacobian_mass_matrix_is_kept_while_the_configuration_moves_little() {
+    let mut r = robot(FrictionModel::LuGre, |_| {});
+    let q = r.model.touching_ground(&joints(&[0, 1, 2, 3, 4, 5]));
+    let n = q.len();
+    let (qd, qdd) = (vec![0.0; n], vec![0.0; n]);
+    let exact_mass = |r: &mut Robot, q: &[f64]| {
+        let mut m = nalgebra::DMatrix::zeros(n, n);
+        assert!(r.mass_matrix(0.0, q, &qd, &qdd, &mut m));
+        m
+    };
+    let jacobian_mass = |r: &mut Robot, q: &[f64]| {
+        let mut jac = Jacobian::zeros(n);
+        assert!(r.jacobian(0.0, q, &qd, &qdd, &mut jac));
+        jac.m
+    };
+    let first = jacobian_mass(&mut r, &q);
+    assert_eq!(first, exact_mass(&mut r, &q));
+    // q_r of leg 0 (coordinate 6) turned by 0.05 rad: the kept matrix, no longer the exact one.
+    let mut near = q.clone();
+    near[6] += 0.05;
+    let kept = jacobian_mass(&mut r, &near);
+    assert_eq!(kept, first);
+    assert!((&kept - exact_mass(&mut r, &near)).amax() > 1e-9 * kept.amax(), "M depends on q_r");
+    // 0.3 rad: re-taken.
+    let mut far = q.clone();
+    far[6] += 0.3;
+    assert_eq!(jacobian_mass(&mut r, &far), exact_mass(&mut r, &far));
+}
+
 /// Section 6.2: the unpowered robot on six legs for 10 s. With LuGre the height changes by less
 /// than 0.05 mm; without friction the body sinks steadily (millimetres, slowed by the closed
 /// motor circuits); dry/viscous lies in between.
