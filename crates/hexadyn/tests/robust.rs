@@ -112,6 +112,12 @@ fn input_files_are_bounded_regular_files() {
     assert!(s.contains("not a regular file"), "{s}");
     let e = Scenario::from_file("/dev/zero").unwrap_err().to_string();
     assert!(e.contains("not a regular file"), "{e}");
+    // The terrain files too: a PLY mesh and a CSV of heights.
+    let s = rejected(&with("free_gait_rough_spline", "file = \"terrains/rough_ground.ply\"", "file = \"/dev/zero\""), "terrain.file");
+    assert!(s.contains("not a regular file"), "{s}");
+    let heights = with("stand_six_legs", "[control]", "[terrain]\nkind = \"heightfield\"\nfile = \"/dev/zero\"\nspacing_m = 0.1\n\n[control]");
+    let s = rejected(&heights, "terrain.file");
+    assert!(s.contains("not a regular file"), "{s}");
     let dir = std::env::temp_dir().join(format!("hexadyn-robust-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let e = Scenario::from_file(&dir).unwrap_err().to_string();

@@ -23,29 +23,39 @@ mod span_index;
 pub(crate) use bounded::{bounds, seq, Bound, Finite, NonNegative, Positive, Value, Violation};
 pub(crate) use span_index::SpanIndex;
 
-/// The largest input file read (scenario, robot description, heading CSV, link configuration):
+/// The largest text input file read (scenario, robot description, heading and height CSV, link configuration):
 /// 64 MB, far above any real one (kilobytes; a 1000 s heading series at 100 Hz is 4 MB), so
 /// that naming a device (`/dev/zero`) or a huge file fails at once instead of filling memory.
 pub const MAX_INPUT_BYTES: u64 = 64 << 20;
 
-/// Reads an input file as text: a regular file of at most [`MAX_INPUT_BYTES`], in UTF-8. The
-/// error is a one-line reason.
-pub fn read_input(path: impl AsRef<std::path::Path>) -> std::result::Result<String, String> {
+/// The largest terrain mesh file read: 1 GB, a binary PLY of about 40 million triangles.
+pub const MAX_MESH_BYTES: u64 = 1 << 30;
+
+/// Reads an input file's bytes: a regular file of at most `limit` bytes, so that naming a
+/// device (`/dev/zero`) or a huge file fails at once instead of filling memory. The error is a
+/// one-line reason.
+pub fn read_input_bytes(path: impl AsRef<std::path::Path>, limit: u64) -> std::result::Result<Vec<u8>, String> {
     use std::io::Read;
-    let path = path.as_ref();
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let file = std::fs::File::open(path.as_ref()).map_err(|e| e.to_string())?;
     let meta = file.metadata().map_err(|e| e.to_string())?;
     if !meta.is_file() {
         return Err(if meta.is_dir() { "a directory, not a file".into() } else { "not a regular file".into() });
     }
-    if meta.len() > MAX_INPUT_BYTES {
-        return Err(format!("{} bytes, more than the {MAX_INPUT_BYTES} allowed for an input file", meta.len()));
+    if meta.len() > limit {
+        return Err(format!("{} bytes, more than the {limit} allowed for an input file", meta.len()));
     }
     let mut bytes = Vec::new();
-    file.take(MAX_INPUT_BYTES + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
-    if bytes.len() as u64 > MAX_INPUT_BYTES {
-        return Err(format!("more than the {MAX_INPUT_BYTES} bytes allowed for an input file"));
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("more than the {limit} bytes allowed for an input file"));
     }
+    Ok(bytes)
+}
+
+/// Reads an input file as text: a regular file of at most [`MAX_INPUT_BYTES`]
+/// ([`read_input_bytes`]), in UTF-8. The error is a one-line reason.
+pub fn read_input(path: impl AsRef<std::path::Path>) -> std::result::Result<String, String> {
+    let bytes = read_input_bytes(path, MAX_INPUT_BYTES)?;
     String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (invalid byte at offset {})", e.utf8_error().valid_up_to()))
 }
 

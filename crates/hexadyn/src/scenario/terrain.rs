@@ -109,7 +109,7 @@ pub(super) fn validate(raw: Option<&RawTerrain>, c: &Ctx, dir: &Path) -> Result<
 
 /// The rows of a CSV file of numbers (blank lines skipped).
 fn read_heights(path: &Path) -> Result<Vec<Vec<f64>>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text = crate::fields::read_input(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let mut rows = Vec::new();
     for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let row = line

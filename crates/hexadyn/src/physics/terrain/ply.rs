@@ -37,7 +37,7 @@ pub struct PlyFormat {
 /// Reads a terrain mesh from a PLY file.
 pub fn read_terrain(path: &Path) -> Result<MeshTerrain, PlyError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| PlyError { file: file.clone(), element: "file".into(), problem: e.to_string() })?;
+    let bytes = crate::fields::read_input_bytes(path, crate::fields::MAX_MESH_BYTES).map_err(|problem| PlyError { file: file.clone(), element: "file".into(), problem })?;
     parse_terrain(&bytes, &file)
 }
 
