@@ -8,9 +8,9 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::terrain::{Proximity, Terrain};
 #[cfg(test)]
 use super::terrain::{FlatGround, Slope};
+use super::terrain::{Proximity, Terrain};
 
 /// Parameters of the contact law, Eq. 3.72-3.73.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -76,9 +76,9 @@ impl GroundContact {
     ///
     /// The penetration δ and the normal n are those of the closest point of the terrain to the
     /// foot's centre p ([`Terrain::proximity`]); on a plane, δ = n · (p_s - p) + r with
-    /// p_s = (x, y, h(x, y)) below the foot. The Jacobians treat the tangent plane at the closest
-    /// point as fixed (∂δ/∂p = -nᵀ, the gradient of the distance): exact on planar faces, the
-    /// curvature × penetration terms of edges and vertices are neglected.
+    /// p_s = (x, y, h(x, y)) below the foot. The penetration rate is dδ/dt = ∇δ · v (-n · v on a
+    /// face). The Jacobians take ∇δ, its derivative and ∂n/∂p from the terrain: exact on faces
+    /// and planes, around edges and vertices and for the blended normal inside the ground.
     ///
     /// For δ > 0, F_n = K δ^p_K + D δ^p_D dδ/dt (Eq. 3.72), clamped at zero: the ground never
     /// pulls the foot (no adhesion when the foot leaves the ground faster than the damping
@@ -92,8 +92,8 @@ impl GroundContact {
     /// The contact force of [`Self::force`] on a foot moving at `v` whose contact geometry with
     /// the ground (for a foot sphere of radius [`Self::foot_radius`]) is `proximity`.
     pub fn force_at(&self, proximity: Proximity, v: &Vector3<f64>) -> ContactForce {
-        let Proximity { penetration: delta, normal: n } = proximity;
-        let delta_rate = -n.dot(v);
+        let Proximity { penetration: delta, normal: n, penetration_gradient: grad, penetration_hessian: hessian, normal_jacobian: dn_dp } = proximity;
+        let delta_rate = grad.dot(v);
         let projector = Matrix3::identity() - n * n.transpose();
         let slip = projector * v;
         let mut out = ContactForce {
@@ -116,21 +116,24 @@ impl GroundContact {
         out.elastic_energy = spring * delta / (self.p_k + 1.0);
         let f_n = spring + damping * delta_rate;
         if f_n > 0.0 {
-            // ∂F_n/∂δ and ∂F_n/∂(dδ/dt); ∂δ/∂p = ∂(dδ/dt)/∂v = -nᵀ.
+            // ∂F_n/∂δ and ∂F_n/∂(dδ/dt); ∂δ/∂p = ∂(dδ/dt)/∂v = ∇δᵀ, ∂(dδ/dt)/∂p = vᵀ ∂∇δ/∂p.
             let dfn_ddelta = self.p_k * spring / delta + self.p_d * damping / delta * delta_rate;
-            let dfn_dp = -dfn_ddelta * n.transpose();
-            let dfn_dv = -damping * n.transpose();
+            let dfn_dp = dfn_ddelta * grad.transpose() + damping * (v.transpose() * hessian);
+            let dfn_dv = damping * grad.transpose();
+            // ∂v_g/∂p = -(∂n/∂p (n · v) + n vᵀ ∂n/∂p).
+            let dslip_dp = -(dn_dp * n.dot(v) + n * (v.transpose() * dn_dp));
             let speed = slip.norm();
             let (friction, dft_dp, dft_dv) = if speed < self.v_glim {
                 let c = self.mu / self.v_glim;
-                (-c * f_n * slip, -c * slip * dfn_dp, -c * (slip * dfn_dv + f_n * projector))
+                (-c * f_n * slip, -c * (slip * dfn_dp + f_n * dslip_dp), -c * (slip * dfn_dv + f_n * projector))
             } else {
                 let u = slip / speed;
-                (-self.mu * f_n * u, -self.mu * u * dfn_dp, -self.mu * (u * dfn_dv + f_n / speed * (projector - u * u.transpose())))
+                let turn = (Matrix3::identity() - u * u.transpose()) * (f_n / speed);
+                (-self.mu * f_n * u, -self.mu * (u * dfn_dp + turn * dslip_dp), -self.mu * (u * dfn_dv + turn * projector))
             };
             out.normal_force = f_n;
             out.force = f_n * n + friction;
-            out.df_dp = n * dfn_dp + dft_dp;
+            out.df_dp = n * dfn_dp + f_n * dn_dp + dft_dp;
             out.df_dv = n * dfn_dv + dft_dv;
         }
         out.absorbed_power = -out.force.dot(v);
@@ -194,6 +197,49 @@ mod tests {
             assert!((c.slip_velocity.norm() - slip).abs() < 1e-9 * slip);
             finite_difference_check(&contact, terrain, p, v, 1e-4 * delta, 1e-4 * slip.min((slip - contact.v_glim).abs()));
         }
+    }
+
+    #[test]
+    fn jacobians_match_finite_differences_inside_the_ground_near_edges() {
+        // Point feet sunk 0.2-2 mm into a step's top corner and into a rough heightfield, within
+        // a millimetre of an edge: the blended normal's derivative (terrain module docs) enters
+        // ∂F/∂p through F_n n and the slip's projector; and foot spheres around the edges.
+        use crate::physics::terrain::{Heightfield, Step};
+        let contact = GroundContact::default();
+        let step = Step { base: 0.0, rise: 0.08, edge: 1.0, azimuth: 0.3 };
+        let mut r = rng(22);
+        let heights = (0..8).map(|_| (0..8).map(|_| r.random_range(-0.05..0.05)).collect()).collect();
+        let field = Heightfield::new([0.0, 0.0], 0.1, heights).unwrap();
+        let mut blended = 0;
+        for k in 0..300 {
+            // One in ten, under the step's top, in the blend's fade with the depth (5-7 cm).
+            let delta = if k % 10 == 8 { r.random_range(0.05..0.07) } else { (r.random_range((2e-4f64).ln()..(2e-3f64).ln())).exp() };
+            let (terrain, p): (&dyn Terrain, Vector3<f64>) = if k % 2 == 0 {
+                // Across the corner: s = δ (-1.5..1.5) from the face, δ under the top.
+                let u = Vector3::new(step.azimuth.cos(), step.azimuth.sin(), 0.0);
+                let along = Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0);
+                (&step, u * (step.edge + delta * r.random_range(-1.5..1.5)) + along + Vector3::new(0.0, 0.0, step.rise - delta))
+            } else {
+                // Near the cell edge x = 0.3 (or the diagonal through (0.3, 0.3)).
+                let (x, y) = (0.3 + delta * r.random_range(-1.5..1.5), r.random_range(0.25..0.35));
+                (&field, Vector3::new(x, y, field.height_normal(x, y).0 - delta))
+            };
+            // Every third a foot sphere of 5 mm, its centre above the ground near the edge (the
+            // direction to the edge turns as it moves).
+            let (contact, p) = if k % 3 == 2 { (GroundContact { foot_radius: 5e-3, ..contact }, p + Vector3::new(0.0, 0.0, 5e-3)) } else { (contact, p) };
+            let proximity = terrain.proximity(&p, contact.foot_radius);
+            blended += usize::from(proximity.normal_jacobian != Matrix3::zeros());
+            let n = proximity.normal;
+            let t1 = n.cross(&Vector3::x()).normalize();
+            let t2 = n.cross(&t1);
+            let slip = contact.v_glim * if k % 4 < 2 { r.random_range(0.01..0.99) } else { r.random_range(1.01..100.0) };
+            let a = r.random_range(0.0..std::f64::consts::TAU);
+            let v = slip * (a.cos() * t1 + a.sin() * t2) - r.random_range(-0.5..0.5) * contact.k_gnd * delta / contact.d_gnd * n;
+            if proximity.penetration > 0.0 {
+                finite_difference_check(&contact, terrain, p, v, 1e-5 * delta, 1e-4 * slip.min((slip - contact.v_glim).abs()));
+            }
+        }
+        assert!(blended > 100, "only {blended} of 300 points in a blend");
     }
 
     #[test]

@@ -25,14 +25,7 @@ impl Default for StaticOptions {
 /// keep their given value; a row whose coordinate is locked is not required to vanish (the
 /// locked coordinate's generalized force is the reaction that holds it). Newton-Raphson on
 /// KT / CT with backtracking on the residual norm.
-pub fn static_equilibrium<S: System + ?Sized>(
-    sys: &mut S,
-    t: f64,
-    q: &mut [f64],
-    qd: &mut [f64],
-    locked: &[usize],
-    options: &StaticOptions,
-) -> Result<(), SimError> {
+pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64], qd: &mut [f64], locked: &[usize], options: &StaticOptions) -> Result<(), SimError> {
     let n = q.len();
     let orders = sys.layout().orders.clone();
     let free: Vec<usize> = (0..n).filter(|i| !locked.contains(i)).collect();
@@ -75,36 +68,51 @@ pub fn static_equilibrium<S: System + ?Sized>(
             }
         }
         // A tangent stiffness that vanishes in some direction (a foot just touching the
-        // ground, Eq. 3.72 with δ = 0) is regularized Levenberg-Marquardt style: the backtracking
-        // below then takes the useful fraction of the step.
+        // ground, Eq. 3.72 with δ = 0) is regularized Levenberg-Marquardt style, and so is a
+        // step along which the backtracking finds no decrease of the residual: the damping
+        // grows a hundredfold until one does (the step turns towards the gradient and
+        // shortens). Past the largest damping the backtracking's last step is taken.
         let scale = (0..k).map(|i| a[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let (q0, qd0) = (q.to_vec(), qd.to_vec());
         let mut damping = 0.0;
-        let dx = loop {
+        loop {
             let mut damped = a.clone();
             for i in 0..k {
                 damped[(i, i)] += damping;
             }
-            match damped.lu().solve(&rhs) {
-                Some(dx) if dx.iter().all(|x| x.is_finite()) => break dx,
-                _ if damping < scale => damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 },
-                _ => return Err(SimError::Singular { what: "static tangent stiffness", t }),
-            }
-        };
-        let (q0, qd0) = (q.to_vec(), qd.to_vec());
-        let mut lambda = 1.0;
-        loop {
-            for (c, &j) in free.iter().enumerate() {
-                match orders[j] {
-                    Order::Second => q[j] = q0[j] - lambda * dx[c],
-                    Order::First => qd[j] = qd0[j] - lambda * dx[c],
+            let dx = match damped.lu().solve(&rhs) {
+                Some(dx) if dx.iter().all(|x| x.is_finite()) => dx,
+                _ if damping < scale => {
+                    damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 };
+                    continue;
                 }
-            }
-            let trial = norm(sys, q, qd, &mut f);
-            if trial.is_finite() && (trial < current || lambda < 1e-4) {
-                current = trial;
+                _ => return Err(SimError::Singular { what: "static tangent stiffness", t }),
+            };
+            let mut lambda = 1.0;
+            let decreased = loop {
+                for (c, &j) in free.iter().enumerate() {
+                    match orders[j] {
+                        Order::Second => q[j] = q0[j] - lambda * dx[c],
+                        Order::First => qd[j] = qd0[j] - lambda * dx[c],
+                    }
+                }
+                let trial = norm(sys, q, qd, &mut f);
+                if trial.is_finite() && trial < current {
+                    current = trial;
+                    break true;
+                }
+                if lambda < 1e-4 {
+                    break false;
+                }
+                lambda *= 0.5;
+            };
+            if decreased || damping >= 1e6 * scale {
+                if !decreased {
+                    current = norm(sys, q, qd, &mut f);
+                }
                 break;
             }
-            lambda *= 0.5;
+            damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 };
         }
     }
     sys.residual(t, q, qd, &qdd, &mut f);

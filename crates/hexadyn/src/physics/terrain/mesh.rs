@@ -1,13 +1,13 @@
 //! A terrain given as a triangle mesh, queried through parry3d-f64.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::partitioning::BvhNode;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags, TrianglePointLocation};
 
-use super::{Extent, Proximity, Terrain, Triangles};
+use super::{feature_normal_jacobian, Extent, InsideNormal, Proximity, Terrain, Triangles};
 
 /// Why triangles do not make a terrain mesh.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -34,10 +34,11 @@ fn from_parry(v: PVec) -> Vector3<f64> {
 /// answers the closest point, with the angle-weighted pseudo-normals of its edges and vertices
 /// (`TriMeshFlags::ORIENTED`) deciding on which side of the surface a point is.
 ///
-/// The contact normal is the face's own normal when the closest point is inside a face, and the
-/// direction between the foot and its closest point on an edge or a vertex: on a plane tiled
-/// by triangles both are the plane's normal, so a foot sliding across the internal edges feels
-/// no jump. A terrain is seen from above: faces whose normal points down are turned over;
+/// Above the ground the contact normal is the face's own normal when the closest point is inside
+/// a face, and the direction from its closest point on an edge or a vertex to the foot: on a
+/// plane tiled by triangles both are the plane's normal, so a foot sliding across the internal
+/// edges feels no jump. Inside the ground it is the blend of the near faces' normals
+/// ([`InsideNormal`], continuous under convex edges and vertices; the module docs). A terrain is seen from above: faces whose normal points down are turned over;
 /// vertical faces keep the file's orientation, which must point out of the ground
 /// (counter-clockwise seen from outside, as Blender exports). The mesh must cover the ground
 /// the feet reach: beyond its border there is no ground.
@@ -118,7 +119,7 @@ impl Terrain for MeshTerrain {
     fn proximity(&self, p: &Vector3<f64>, radius: f64) -> Proximity {
         let c = to_parry(p);
         let (projection, (face, location)) = self.mesh.project_local_point_and_get_location(c, false);
-        self.contact(c, face, projection.point, location, radius)
+        self.contact(c, face, projection.point, location, radius, None)
     }
 
     /// The closest face among the vicinity's when no face outside it can be closer; otherwise
@@ -126,11 +127,12 @@ impl Terrain for MeshTerrain {
     fn proximity_near(&self, p: &Vector3<f64>, radius: f64, vicinity: &mut Vicinity) -> Proximity {
         let c = to_parry(p);
         if let Some((face, point, location)) = vicinity.closest(&self.mesh, c) {
-            return self.contact(c, face, point, location, radius);
+            return self.contact(c, face, point, location, radius, Some(vicinity));
         }
         let (projection, (face, location)) = self.mesh.project_local_point_and_get_location(c, false);
-        vicinity.gather(&self.mesh, c, (projection.point - c).length() + VICINITY_MARGIN);
-        self.contact(c, face, projection.point, location, radius)
+        // Wide enough for the faces of the inside normal's blend, within twice the distance.
+        vicinity.gather(&self.mesh, c, 2.0 * (projection.point - c).length() + VICINITY_MARGIN);
+        self.contact(c, face, projection.point, location, radius, Some(vicinity))
     }
 
     fn triangles(&self, _extent: Extent) -> Triangles {
@@ -140,13 +142,14 @@ impl Terrain for MeshTerrain {
 
 impl MeshTerrain {
     /// The contact of a foot sphere of `radius` centred at `c` whose closest point of the mesh
-    /// is `point`, at `location` on `face`.
-    fn contact(&self, c: PVec, face: u32, point: PVec, location: TrianglePointLocation, radius: f64) -> Proximity {
+    /// is `point`, at `location` on `face`; inside the ground, the faces of the normal's blend
+    /// are looked for among the vicinity's when it holds them all.
+    fn contact(&self, c: PVec, face: u32, point: PVec, location: TrianglePointLocation, radius: f64, vicinity: Option<&Vicinity>) -> Proximity {
         let d = c - point;
-        let (distance, n) = match location {
+        let (distance, n, curvature) = match location {
             TrianglePointLocation::OnFace(..) | TrianglePointLocation::OnSolid => {
                 let n = self.normals[face as usize];
-                (n.dot(d), n)
+                (n.dot(d), from_parry(n), Matrix3::zeros())
             }
             TrianglePointLocation::OnEdge(..) | TrianglePointLocation::OnVertex(_) => {
                 let length = d.length();
@@ -155,13 +158,43 @@ impl MeshTerrain {
                     // Inside when behind the feature's pseudo-normal (as parry3d's oriented
                     // `TriMesh` decides it).
                     let sign = if d.dot(pseudo_normal) <= 0.0 { -1.0 } else { 1.0 };
-                    (sign * length, d * (sign / length))
+                    let n = from_parry(d * (sign / length));
+                    (sign * length, n, feature_normal_jacobian(n, self.edge_direction(face, location), sign * length))
                 } else {
-                    (0.0, pseudo_normal.normalize())
+                    (0.0, from_parry(pseudo_normal.normalize()), Matrix3::zeros())
                 }
             }
         };
-        Proximity { penetration: radius - distance, normal: from_parry(n) }
+        let (normal, normal_jacobian) = if distance < 0.0 { self.inside_normal(c, InsideNormal::new(-distance, n, curvature), vicinity) } else { (n, curvature) };
+        Proximity { penetration: radius - distance, normal, penetration_gradient: -n, penetration_hessian: -curvature, normal_jacobian }
+    }
+
+    /// The unit direction of the edge of `face` at `location`; `None` on a vertex.
+    fn edge_direction(&self, face: u32, location: TrianglePointLocation) -> Option<Vector3<f64>> {
+        let TrianglePointLocation::OnEdge(i, _) = location else {
+            return None;
+        };
+        let t = self.mesh.triangle(face);
+        // parry3d's edge numbering of `TrianglePointLocation`: AB, BC, AC.
+        let (from, to) = [(t.a, t.b), (t.b, t.c), (t.a, t.c)][i as usize];
+        Some(from_parry((to - from).normalize()))
+    }
+
+    /// The normal of a foot at `c` inside the ground ([`InsideNormal`]) and its derivative:
+    /// every face within the blend's reach takes part.
+    fn inside_normal(&self, c: PVec, mut blend: InsideNormal, vicinity: Option<&Vicinity>) -> (Vector3<f64>, Matrix3<f64>) {
+        if let Some(reach) = blend.reach() {
+            let mut add = |face: u32| {
+                let d = c - self.mesh.triangle(face).project_local_point(c, false).point;
+                let e = d.length();
+                blend.add(face, from_parry(self.normals[face as usize]), e, from_parry(d / e));
+            };
+            match vicinity {
+                Some(v) if v.holds(c, reach) => v.faces.iter().filter(|(_, aabb)| aabb.distance_to_local_point(c, true) <= reach).for_each(|&(face, _)| add(face)),
+                _ => self.mesh.bvh().leaves(|node: &BvhNode| node.aabb().distance_to_local_point(c, true) <= reach).for_each(add),
+            }
+        }
+        blend.normal()
     }
 
     /// The angle-weighted pseudo-normal (not normalized) of the edge or vertex of `face` at
@@ -224,14 +257,19 @@ impl Vicinity {
                 tie |= distance == best_distance;
             }
         }
-        // A nanometre of slack for the rounding of the bounding boxes' distances.
-        if tie || c.distance(self.centre) + best_distance > self.reach - 1e-9 {
+        if tie || !self.holds(c, best_distance) {
             return None;
         }
         let (k, point, location) = best?;
         // The next query, a little further along, starts from this face.
         self.faces.swap(0, k);
         Some((self.faces[0].0, point, location))
+    }
+
+    /// Whether every face with a point within `distance` of `c` is gathered (type docs).
+    fn holds(&self, c: PVec, distance: f64) -> bool {
+        // A nanometre of slack for the rounding of the bounding boxes' distances.
+        c.distance(self.centre) + distance <= self.reach - 1e-9
     }
 
     /// Gathers the faces whose bounding box comes within `reach` of `centre`.

@@ -12,6 +12,20 @@
 //! (from p to s when p is inside), or the surface's normal where p lies on it. With r = 0 this is
 //! the thesis' point foot; on a plane it is exactly its tangent-plane law.
 //!
+//! Inside the ground the closest face changes on the bisector of a convex edge (a ridge, the
+//! top corner of a step), where the closest-point normal jumps by the edge's dihedral angle and
+//! a point foot resting there feels a force jump. INTERPRETATION (the thesis' foot is a point
+//! against the tangent plane below it, which has no answer at an edge): inside the ground the
+//! normal is the faces' normals weighted by how near each face is compared with the closest
+//! ([`InsideNormal`]): a face at distance e from a foot whose closest face is at e_min weighs
+//! φ((e - e_min) / (β e_min)), φ(u) = (1 - u)² (1 + 2u) on [0, 1] and 0 beyond, β = 1
+//! ([`INSIDE_BLEND_BAND`]). The normal turns continuously (C¹ in e) from one face's over the
+//! bisector, where it is their mean, to the other's; on a face farther than 2 e_min from every
+//! other face, and on a plane tiled by triangles, it is the face's normal. The penetration
+//! stays the exact distance: the force is continuous, its spring not exactly conservative
+//! inside the band (a foot would have to circle around the edge within it, sub-millimetre, to
+//! gain or lose energy).
+//!
 //! - [`FlatGround`], [`Slope`]: planes (analytic);
 //! - [`Step`]: two horizontal half planes joined by a vertical face (analytic closest point);
 //! - [`MeshTerrain`]: a triangle mesh (parry3d-f64's `TriMesh` with its BVH and the
@@ -33,7 +47,7 @@ pub use heightfield::Heightfield;
 pub use mesh::{MeshError, MeshTerrain, Vicinity};
 pub use step::Step;
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 /// The contact geometry of a foot sphere with the ground (closest point).
@@ -44,6 +58,136 @@ pub struct Proximity {
     pub penetration: f64,
     /// Unit normal n of the contact, out of the ground towards the foot.
     pub normal: Vector3<f64>,
+    /// ∇δ = ∂δ/∂p: minus the closest-point normal n_c, the unit vector between the foot and
+    /// its closest point (-n on a face; inside the ground n is the blend of the module docs,
+    /// n_c is not).
+    pub penetration_gradient: Vector3<f64>,
+    /// ∂∇δ/∂p = -∂n_c/∂p: zero on a face; where the closest point is on an edge or a vertex,
+    /// the turning of n_c as the foot moves around it ([`feature_normal_jacobian`]).
+    pub penetration_hessian: Matrix3<f64>,
+    /// ∂n/∂p: ∂n_c/∂p above the ground, the blend's derivative inside it.
+    pub normal_jacobian: Matrix3<f64>,
+}
+
+/// ∂n_c/∂p for a foot at signed distance `distance` (> 0 above the ground) from its closest
+/// point on an edge along the unit vector `edge` or on a vertex (`None`), n_c the unit vector
+/// from that point to the foot above the ground (from the foot to it inside):
+/// (I - n_c n_cᵀ - t tᵀ) / distance, the closest point sliding along the edge.
+pub(crate) fn feature_normal_jacobian(normal: Vector3<f64>, edge: Option<Vector3<f64>>, distance: f64) -> Matrix3<f64> {
+    let along = edge.map_or(Matrix3::zeros(), |t| t * t.transpose());
+    (Matrix3::identity() - normal * normal.transpose() - along) / distance
+}
+
+/// β of the inside normal's blend (module docs): faces within (1 + β) times the closest
+/// distance take part. 1: the normal turns over a band as wide as the penetration itself,
+/// about a millimetre for a foot carrying its share of AMRU5 on the ground of Table 3.3, far
+/// wider than what a foot on the ground moves in a step.
+pub const INSIDE_BLEND_BAND: f64 = 1.0;
+
+/// Depth (m) beyond which the inside normal's blend fades back to the closest-point normal,
+/// which it reaches at twice this depth. A point far inside the ground is about as far from
+/// every face of a small mesh, so the blend would take them all: a state the solvers may try
+/// on their way (a Newton step through a singular stiffness), not one the contact law
+/// describes. INTERPRETATION: 5 cm, above any Hertz penetration the shipped grounds give (a few
+/// millimetres on Table 3.3's, 3 cm on the soft ground of the enhanced-foot scenarios).
+pub const INSIDE_BLEND_DEPTH: f64 = 0.05;
+
+/// φ(u) = (1 - u)² (1 + 2u) on [0, 1], 1 below, 0 above, and φ'(u).
+fn smooth_step_down(u: f64) -> (f64, f64) {
+    if u <= 0.0 {
+        (1.0, 0.0)
+    } else if u >= 1.0 {
+        (0.0, 0.0)
+    } else {
+        ((1.0 - u) * (1.0 - u) * (1.0 + 2.0 * u), -6.0 * u * (1.0 - u))
+    }
+}
+
+/// The normal of a foot inside the ground, at depth e_min > 0 under its closest face, blended
+/// from the normals of the faces near it (module docs). Faces with the same normal (coplanar
+/// tiles of one face) count once, with the largest of their weights, so that how a face is
+/// cut into triangles does not matter. The blend does not depend on the order the faces come
+/// in: each normal is represented by its face of lowest key, and the sum runs in key order.
+pub(crate) struct InsideNormal {
+    depth: f64,
+    /// The closest-point normal n_c (∇e_min = -n_c) and ∂n_c/∂p.
+    closest: (Vector3<f64>, Matrix3<f64>),
+    /// The fade to n_c with the depth ([`INSIDE_BLEND_DEPTH`]) and its derivative in the depth.
+    fade: (f64, f64),
+    /// Distinct normals: (key of the face representing it, unit normal, weight, its gradient).
+    normals: [(u32, Vector3<f64>, f64, Vector3<f64>); 8],
+    len: usize,
+    /// The weighted normals of more distinct faces than `normals` holds (not grouped), and
+    /// their derivative ∂/∂p.
+    overflow: (Vector3<f64>, Matrix3<f64>),
+}
+
+impl InsideNormal {
+    /// A foot at depth e_min under its closest point, whose normal n_c is `closest` with
+    /// ∂n_c/∂p = `closest_jacobian`.
+    pub(crate) fn new(depth: f64, closest: Vector3<f64>, closest_jacobian: Matrix3<f64>) -> Self {
+        let (fade, slope) = smooth_step_down(depth / INSIDE_BLEND_DEPTH - 1.0);
+        InsideNormal {
+            depth,
+            closest: (closest, closest_jacobian),
+            fade: (fade, slope / INSIDE_BLEND_DEPTH),
+            normals: [(0, Vector3::zeros(), 0.0, Vector3::zeros()); 8],
+            len: 0,
+            overflow: (Vector3::zeros(), Matrix3::zeros()),
+        }
+    }
+
+    /// How far from the foot a face can take part, (1 + β) e_min; `None` when the blend has
+    /// faded out (no face takes part).
+    pub(crate) fn reach(&self) -> Option<f64> {
+        (self.fade.0 > 0.0).then_some((1.0 + INSIDE_BLEND_BAND) * self.depth)
+    }
+
+    /// The face of key `key` (its index), unit normal `normal`, at `distance` e from the foot,
+    /// ∇e = `gradient` (the unit vector from its closest point to the foot).
+    pub(crate) fn add(&mut self, key: u32, normal: Vector3<f64>, distance: f64, gradient: Vector3<f64>) {
+        let ratio = distance / self.depth;
+        let (weight, slope) = smooth_step_down((ratio - 1.0) / INSIDE_BLEND_BAND);
+        if weight == 0.0 {
+            return;
+        }
+        // ∇w = φ'(u) ∇u, ∇u = (∇e - (e / e_min) ∇e_min) / (β e_min).
+        let weight_gradient = slope / (INSIDE_BLEND_BAND * self.depth) * (gradient + ratio * self.closest.0);
+        if let Some(entry) = self.normals[..self.len].iter_mut().find(|(_, n, _, _)| n.dot(&normal) > 1.0 - 1e-12) {
+            if key < entry.0 {
+                (entry.0, entry.1) = (key, normal);
+            }
+            if weight > entry.2 {
+                (entry.2, entry.3) = (weight, weight_gradient);
+            }
+        } else if self.len < self.normals.len() {
+            self.normals[self.len] = (key, normal, weight, weight_gradient);
+            self.len += 1;
+        } else {
+            self.overflow.0 += weight * normal;
+            self.overflow.1 += normal * weight_gradient.transpose();
+        }
+    }
+
+    /// The unit normal n = s / |s|, s = f Σ w n_face + (1 - f) n_c with the fade f, and
+    /// ∂n/∂p = (I - n nᵀ) (∂s/∂p) / |s|; n_c when the faces' normals cancel (opposite faces
+    /// equally near: a wall thinner than twice the depth).
+    pub(crate) fn normal(&mut self) -> (Vector3<f64>, Matrix3<f64>) {
+        let normals = &mut self.normals[..self.len];
+        normals.sort_unstable_by_key(|entry| entry.0);
+        let (blend, blend_jacobian) = normals.iter().fold(self.overflow, |(s, ds), (_, n, w, dw)| (s + *w * n, ds + n * dw.transpose()));
+        let ((n_c, dn_c), (fade, fade_slope)) = (self.closest, self.fade);
+        // ∇f = f'(e_min) ∇e_min = -f' n_c.
+        let sum = fade * blend + (1.0 - fade) * n_c;
+        let sum_jacobian = fade * blend_jacobian + (1.0 - fade) * dn_c - fade_slope * (blend - n_c) * n_c.transpose();
+        let norm = sum.norm();
+        if norm > 1e-9 {
+            let n = sum / norm;
+            (n, (Matrix3::identity() - n * n.transpose()) * sum_jacobian / norm)
+        } else {
+            (n_c, dn_c)
+        }
+    }
 }
 
 /// Triangles of a terrain's surface (vertices in m, faces counter-clockwise seen from above, so
@@ -137,17 +281,14 @@ impl Terrain for Slope {
 /// δ = n · (p_s - p) + r = n_z (h - p_z) + r (Section 3.4.2: a point against a plane).
 fn plane_proximity(plane: &dyn Terrain, p: &Vector3<f64>, radius: f64) -> Proximity {
     let (h, n) = plane.height_normal(p.x, p.y);
-    Proximity { penetration: n.z * (h - p.z) + radius, normal: n }
+    Proximity { penetration: n.z * (h - p.z) + radius, normal: n, penetration_gradient: -n, penetration_hessian: Matrix3::zeros(), normal_jacobian: Matrix3::zeros() }
 }
 
 /// Two triangles covering a plane over `extent`.
 fn plane_triangles(plane: &dyn Terrain, extent: Extent) -> Triangles {
     let ([cx, cy], w) = (extent.centre, extent.half_width);
     let corner = |x: f64, y: f64| [x, y, plane.height_normal(x, y).0];
-    Triangles {
-        vertices: vec![corner(cx - w, cy - w), corner(cx + w, cy - w), corner(cx + w, cy + w), corner(cx - w, cy + w)],
-        faces: vec![[0, 1, 2], [0, 2, 3]],
-    }
+    Triangles { vertices: vec![corner(cx - w, cy - w), corner(cx + w, cy - w), corner(cx + w, cy + w), corner(cx - w, cy + w)], faces: vec![[0, 1, 2], [0, 2, 3]] }
 }
 
 #[cfg(test)]

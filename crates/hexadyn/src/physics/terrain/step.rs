@@ -1,8 +1,8 @@
 //! An analytic step: two horizontal half planes joined by a vertical face.
 
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
-use super::{Extent, Proximity, Terrain, Triangles};
+use super::{feature_normal_jacobian, Extent, InsideNormal, Proximity, Terrain, Triangles};
 
 /// The ground at z = `base` on the low side of a straight edge and z = `base` + `rise` on the
 /// high side, joined by a vertical face. The edge is the line u · (x, y) = `edge`, u the
@@ -12,12 +12,13 @@ use super::{Extent, Proximity, Terrain, Triangles};
 /// the surface is the polyline low half line, vertical face, high half line. A foot above the
 /// top corner is pushed away from the corner (the normal turns continuously from vertical to
 /// horizontal over the corner's Voronoi region: the corner acts as a rounded edge of zero
-/// radius); a foot that penetrated is pushed out through the nearest face, so a point foot that
-/// sinks into the top face near the corner is pushed up while it is closer to the top face and
-/// sideways once it is closer to the vertical face. That switch, on the corner's bisector, and
-/// the same one in the concave corner at the foot of the face (a foot touching both faces feels
-/// only the nearer one) are real discontinuities of the contact normal: a sharp edge has no
-/// unique normal.
+/// radius). Inside the ground the normal is the blend of the three faces' normals by their
+/// distances ([`InsideNormal`]): a point foot sunk into the top face near the corner is pushed
+/// up while the vertical face is more than twice as far as the top, then more and more sideways,
+/// along the corner's bisector where both are as far, and sideways only once the top is twice as
+/// far as the face. In front of the face, a foot sphere touching both the face and the low
+/// ground feels only the nearer (the concave corner's discontinuity above the ground, which a
+/// point foot never meets).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Step {
     /// Height of the low side (m).
@@ -48,12 +49,13 @@ impl Step {
         Vector2::new(self.u().dot(p) - self.edge, p.z - self.base)
     }
 
-    /// Closest point of the profile to `q` and its feature.
-    fn closest(&self, q: &Vector2<f64>) -> (Vector2<f64>, Feature) {
+    /// The closest point of each part of the profile to `q` (low half line, vertical face, high
+    /// half line) and its feature.
+    fn candidates(&self, q: &Vector2<f64>) -> [(Vector2<f64>, Feature); 3] {
         let up = Vector2::new(0.0, 1.0);
         let bisector = Vector2::new(-1.0, 1.0).normalize();
         let h = self.rise;
-        let candidates = [
+        [
             // Low half line, s <= 0, w = 0.
             if q.x < 0.0 { (Vector2::new(q.x, 0.0), Feature::Face(up)) } else { (Vector2::zeros(), Feature::Corner(bisector)) },
             // Vertical face, s = 0, 0 <= w <= H.
@@ -66,8 +68,7 @@ impl Step {
             },
             // High half line, s >= 0, w = H.
             if q.x > 0.0 { (Vector2::new(q.x, h), Feature::Face(up)) } else { (Vector2::new(0.0, h), Feature::Corner(bisector)) },
-        ];
-        candidates.into_iter().min_by(|a, b| (q - a.0).norm_squared().total_cmp(&(q - b.0).norm_squared())).expect("three candidates")
+        ]
     }
 }
 
@@ -79,21 +80,38 @@ impl Terrain for Step {
 
     fn proximity(&self, p: &Vector3<f64>, radius: f64) -> Proximity {
         let q = self.profile(p);
-        let (c, feature) = self.closest(&q);
+        let candidates = self.candidates(&q);
+        let (c, feature) = candidates.iter().min_by(|a, b| (q - a.0).norm_squared().total_cmp(&(q - b.0).norm_squared())).expect("three candidates");
         let inside = q.y < 0.0 || (q.x > 0.0 && q.y < self.rise);
-        let (distance, n) = match feature {
-            Feature::Face(n) => (n.dot(&(q - c)), n),
+        let to_space = |n: Vector2<f64>| n.x * self.u() + n.y * Vector3::z();
+        let (distance, closest, curvature) = match feature {
+            Feature::Face(n) => (n.dot(&(q - c)), to_space(*n), Matrix3::zeros()),
             Feature::Corner(bisector) => {
                 let d = (q - c).norm();
                 if d > 0.0 {
                     let sign = if inside { -1.0 } else { 1.0 };
-                    (sign * d, sign * (q - c) / d)
+                    let n = to_space(sign * (q - c) / d);
+                    let edge = Vector3::new(-self.azimuth.sin(), self.azimuth.cos(), 0.0);
+                    (sign * d, n, feature_normal_jacobian(n, Some(edge), sign * d))
                 } else {
-                    (0.0, bisector)
+                    (0.0, to_space(*bisector), Matrix3::zeros())
                 }
             }
         };
-        Proximity { penetration: radius - distance, normal: n.x * self.u() + n.y * Vector3::z() }
+        let (normal, normal_jacobian) = if distance < 0.0 {
+            let mut blend = InsideNormal::new(-distance, closest, curvature);
+            if blend.reach().is_some() {
+                for (part, (point, _)) in candidates.iter().enumerate() {
+                    let face_normal = if part == 1 { Vector2::new(-1.0, 0.0) } else { Vector2::new(0.0, 1.0) };
+                    let e = (q - point).norm();
+                    blend.add(part as u32, to_space(face_normal), e, to_space((q - point) / e));
+                }
+            }
+            blend.normal()
+        } else {
+            (closest, curvature)
+        };
+        Proximity { penetration: radius - distance, normal, penetration_gradient: -closest, penetration_hessian: -curvature, normal_jacobian }
     }
 
     /// A square of the extent's size aligned with the edge: the low part, the face and the high

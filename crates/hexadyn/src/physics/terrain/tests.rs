@@ -45,16 +45,19 @@ fn closest_on_triangle(p: Vector3<f64>, a: Vector3<f64>, b: Vector3<f64>, c: Vec
 
 /// Brute force over all triangles of a ground that every vertical line crosses once (a height
 /// field, possibly with vertical faces): the closest point gives the distance, the side comes
-/// from the height of the surface above or below p on its vertical line.
+/// from the height of the surface above or below p on its vertical line; inside, the normal is
+/// the blend of every triangle's normal (turned up as the mesh turns them) by its distance.
 fn brute_force(t: &Triangles, p: Vector3<f64>, radius: f64) -> Proximity {
     let v = |i: u32| Vector3::from(t.vertices[i as usize]);
     let mut best = (f64::INFINITY, Vector3::zeros(), Vector3::zeros(), false);
     let mut surface_z = f64::NEG_INFINITY;
+    let mut faces = Vec::new();
     for f in &t.faces {
         let (a, b, c) = (v(f[0]), v(f[1]), v(f[2]));
         let (s, on_face) = closest_on_triangle(p, a, b, c);
         let n = (b - a).cross(&(c - a));
         let d = (p - s).norm();
+        faces.push((if n.z < 0.0 { -n } else { n }.normalize(), d, (p - s) / d));
         if d < best.0 {
             best = (d, s, n.normalize(), on_face);
         }
@@ -69,8 +72,22 @@ fn brute_force(t: &Triangles, p: Vector3<f64>, radius: f64) -> Proximity {
     }
     let (d, s, face_normal, on_face) = best;
     let sign = if p.z < surface_z { -1.0 } else { 1.0 };
-    let normal = if on_face { face_normal * face_normal.dot(&(p - s)).signum() * sign } else { sign * (p - s) / d };
-    Proximity { penetration: radius - sign * d, normal }
+    let closest = if on_face { face_normal * face_normal.dot(&(p - s)).signum() * sign } else { sign * (p - s) / d };
+    let normal = if sign < 0.0 {
+        let mut blend = InsideNormal::new(d, closest, nalgebra::Matrix3::zeros());
+        faces.into_iter().enumerate().for_each(|(key, (n, e, gradient))| blend.add(key as u32, n, e, gradient));
+        blend.normal().0
+    } else {
+        closest
+    };
+    // Only the penetration and the normal are compared.
+    Proximity {
+        penetration: radius - sign * d,
+        normal,
+        penetration_gradient: -closest,
+        penetration_hessian: nalgebra::Matrix3::zeros(),
+        normal_jacobian: nalgebra::Matrix3::zeros(),
+    }
 }
 
 fn random_heightfield(seed: u64, n: usize, spacing: f64) -> Heightfield {
@@ -191,7 +208,9 @@ fn analytic_step_matches_its_mesh() {
         for _ in 0..500 {
             let u = Vector3::new(step.azimuth.cos(), step.azimuth.sin(), 0.0);
             // Points near the edge, well inside the meshed square.
-            let p = u * (step.edge + r.random_range(-0.2..0.2)) + Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0) + Vector3::new(0.0, 0.0, step.base + r.random_range(-0.05..step.rise + 0.05));
+            let p = u * (step.edge + r.random_range(-0.2..0.2))
+                + Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0)
+                + Vector3::new(0.0, 0.0, step.base + r.random_range(-0.05..step.rise + 0.05));
             let radius = r.random_range(0.0..0.03);
             let (a, b) = (step.proximity(&p, radius), mesh.proximity(&p, radius));
             assert!((a.penetration - b.penetration).abs() < 1e-9, "{step:?} at {p:?}: δ = {} vs mesh {}", a.penetration, b.penetration);
@@ -210,9 +229,15 @@ fn step_edge_treatment() {
     let d: Vector3<f64> = Vector3::new(-0.01, 0.0, 0.01);
     assert!((p.penetration - (0.02 - d.norm())).abs() < 1e-15);
     assert!((p.normal - d.normalize()).norm() < 1e-15);
-    // A point foot sunk into the top face: up while nearer the top, sideways once nearer the face.
+    // A point foot sunk 5 mm into the top face: up while the face is twice as far as the top
+    // (u = 1), along the bisector where both are as far, sideways once the top is twice as far.
     assert_eq!(step.proximity(&Vector3::new(1.01, 0.0, 0.075), 0.0).normal, Vector3::z());
-    assert_eq!(step.proximity(&Vector3::new(1.004, 0.0, 0.075), 0.0).normal, -Vector3::x());
+    let bisector = step.proximity(&Vector3::new(1.005, 0.0, 0.075), 0.0);
+    assert!((bisector.normal - Vector3::new(-1.0, 0.0, 1.0).normalize()).norm() < 1e-12 && (bisector.penetration - 0.005).abs() < 1e-15);
+    // 4 mm from the face, 5 mm under the top: u = (5 - 4) / 4 = 1/4, φ = (3/4)² (3/2) = 27/32.
+    let near_face = step.proximity(&Vector3::new(1.004, 0.0, 0.075), 0.0);
+    assert!((near_face.normal - Vector3::new(-1.0, 0.0, 27.0 / 32.0).normalize()).norm() < 1e-12 && (near_face.penetration - 0.004).abs() < 1e-15);
+    assert_eq!(step.proximity(&Vector3::new(1.0025, 0.0, 0.075), 0.0).normal, -Vector3::x());
     // In front of the face, low side.
     let p = step.proximity(&Vector3::new(0.97, 0.0, 0.04), 0.0);
     assert!((p.penetration + 0.03).abs() < 1e-15 && p.normal == -Vector3::x());
@@ -276,4 +301,83 @@ fn shipped_terrains_have_the_geometry_of_section_7_7_5() {
     let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64).sqrt();
     assert!((rms - 0.015).abs() < 0.003, "RMS {rms}");
     assert!(rough.vertices.iter().filter(|v| v[0].hypot(v[1]) < 0.6).all(|v| v[2] == 0.0));
+}
+
+/// A ridge of two faces, z = 0.1 - 0.2 |x| near x = 0 (slope angle θ/2 = atan 0.2 each side),
+/// as a mesh of four triangles.
+fn ridge() -> MeshTerrain {
+    let z = |x: f64| 0.1 - 0.2 * x.abs();
+    let vertices = vec![[-1.0, -1.0, z(-1.0)], [0.0, -1.0, z(0.0)], [1.0, -1.0, z(1.0)], [-1.0, 1.0, z(-1.0)], [0.0, 1.0, z(0.0)], [1.0, 1.0, z(1.0)]];
+    MeshTerrain::new(Triangles { vertices, faces: vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]] }).unwrap()
+}
+
+#[test]
+fn inside_normal_under_a_ridge_is_the_analytic_blend() {
+    let ridge = ridge();
+    let (n_left, n_right) = (Vector3::new(-0.2, 0.0, 1.0).normalize(), Vector3::new(0.2, 0.0, 1.0).normalize());
+    // The analytic answer below the ridge line.
+    let analytic = |p: Vector3<f64>| {
+        // The plane's distance where the perpendicular's foot is on the face (x of the same
+        // sign as the face's), else the distance to the ridge line.
+        let distance = |n: Vector3<f64>, side: f64| {
+            let d = n.dot(&(Vector3::new(0.0, 0.0, 0.1) - p));
+            if (p + d * n).x * side >= 0.0 {
+                d
+            } else {
+                (p.x * p.x + (0.1 - p.z).powi(2)).sqrt()
+            }
+        };
+        let (d_left, d_right) = (distance(n_left, -1.0), distance(n_right, 1.0));
+        let (e_min, e_other, n_near, n_far) = if d_left <= d_right { (d_left, d_right, n_left, n_right) } else { (d_right, d_left, n_right, n_left) };
+        let u = ((e_other - e_min) / e_min).min(1.0);
+        ((n_near + (1.0 - u).powi(2) * (1.0 + 2.0 * u) * n_far).normalize(), e_min)
+    };
+    for x in [-3e-4, -1e-4, -2e-5, 0.0, 1e-6, 5e-5, 2e-4, 6e-4] {
+        let p = Vector3::new(x, 0.3, 0.1 - 1e-3);
+        let (normal, depth) = analytic(p);
+        let got = ridge.proximity(&p, 0.0);
+        assert!((got.normal - normal).norm() < 1e-12, "x = {x}: {:?} vs {normal:?}", got.normal);
+        assert!((got.penetration - depth).abs() < 1e-15, "x = {x}: δ = {} vs {depth}", got.penetration);
+    }
+    // Deep inside, the blend fades back to the closest face's normal: fully at 10 cm, halfway
+    // (φ(1/2) = 1/2) at 7.5 cm.
+    // A nanometre left of the bisector, the right face weighs φ(≈1e-8) = 1 in the blend.
+    let deep = |depth: f64| ridge.proximity(&Vector3::new(-1e-9, 0.0, 0.1 - depth / n_left.z), 0.0).normal;
+    assert!((deep(0.1) - n_left).norm() < 1e-15);
+    let want = (0.5 * (n_left + n_right) + 0.5 * n_left).normalize();
+    assert!((deep(0.075) - want).norm() < 1e-8, "{:?} vs {want:?}", deep(0.075));
+    // On the bisector the mean of the two faces' normals; far from it, the face's own.
+    assert!((ridge.proximity(&Vector3::new(0.0, 0.0, 0.099), 0.0).normal - Vector3::z()).norm() < 1e-15);
+    assert!((ridge.proximity(&Vector3::new(0.01, 0.0, 0.097), 0.0).normal - n_right).norm() < 1e-15);
+}
+
+#[test]
+fn a_point_foot_crossing_convex_edges_inside_the_ground_feels_a_continuous_normal() {
+    // Point feet 1 mm inside a random rough heightfield (10 cm cells, ±5 cm: dihedral angles of
+    // tens of degrees) slide along random lines in 0.1 µm steps: the normal may turn by at most
+    // what a band of the penetration's width allows, never by an edge's dihedral angle.
+    let field = random_heightfield(37, 12, 0.1);
+    let mut r = rng(38);
+    let mut turned = 0.0f64;
+    for line in 0..60 {
+        // From 1 mm before a grid line x = 0.2-0.8 or y = 0.2-0.8 (edges of the cells, convex or
+        // concave at random) across it, at up to 60° from its normal.
+        let grid = 0.1 * r.random_range(2..9) as f64 - 1e-3;
+        let (x, y) = if line % 2 == 0 { (grid, r.random_range(0.2..0.8)) } else { (r.random_range(0.2..0.8), grid) };
+        let direction = r.random_range(-1.0..1.0) + if line % 2 == 0 { 0.0 } else { std::f64::consts::FRAC_PI_2 };
+        let along = Vector3::new(direction.cos(), direction.sin(), 0.0);
+        let mut last: Option<Vector3<f64>> = None;
+        for k in 0..20_000 {
+            let q = Vector3::new(x, y, 0.0) + along * (k as f64 * 1e-7);
+            let p = Vector3::new(q.x, q.y, field.height_normal(q.x, q.y).0 - 1e-3);
+            let n = field.proximity(&p, 0.0).normal;
+            if let Some(m) = last {
+                turned = turned.max((n - m).norm());
+            }
+            last = Some(n);
+        }
+    }
+    // Over a band of about 1 mm (1e4 steps) the normal turns by at most the dihedral angle (< 1 rad):
+    // a step of 1e-7 m turns it by about 1e-4; a jump at the bisector would be 0.1-1.
+    assert!(turned < 2e-3, "the normal turned by {turned} in one 0.1 µm step");
 }
