@@ -206,7 +206,9 @@ fn input_change_is_the_difference_of_two_residuals() {
                 cut += (0..JOINTS).filter(|&k| second.voltages[k] != 0.0 && r.voltages[k] == 0.0).count();
             }
         }
-        assert!(!r.input_change(0.0, &vec![0.0; n], &vec![0.0; n], &vec![0.0; n], &[0.0; 3], &mut df), "inputs of the wrong length");
+        let zeros = vec![0.0; n];
+        assert!(!r.input_change(0.0, &zeros, &zeros, &zeros, &[0.0; 3], &mut df), "inputs of the wrong length");
+        assert!(!r.input_change(0.0, &zeros, &zeros, &zeros, &[0.0; JOINTS], &mut [0.0; 3]), "Δf of the wrong length");
     }
     assert!(saturated > 100 && cut > 20, "saturated voltages {saturated}, cut by the limit switches {cut}");
 }

@@ -686,7 +686,7 @@ impl System for Robot {
     /// reference q_d of a continuous PID through its error ε = q_d − q_j into the integral row
     /// of Eq. 3.97.
     fn input_change(&mut self, _t: f64, _q: &[f64], qd: &[f64], qdd: &[f64], previous: &[f64], df: &mut [f64]) -> bool {
-        if previous.len() != JOINTS {
+        if previous.len() != JOINTS || df.len() != self.model.layout.len() {
             return false;
         }
         df.fill(0.0);

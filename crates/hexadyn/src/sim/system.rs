@@ -84,7 +84,7 @@ pub trait System {
     /// enter f affinely through known functions (a motor voltage through Eq. 4.4, a reference
     /// through a controller's error) this costs no kinematics, unlike two evaluations of
     /// [`Self::residual`]. Returns false when the system cannot do it (the default), or when
-    /// `previous` does not hold [`Self::input_count`] values.
+    /// `previous` does not hold [`Self::input_count`] values or `df` one per coordinate.
     fn input_change(&mut self, _t: f64, _q: &[f64], _qd: &[f64], _qdd: &[f64], _previous: &[f64], _df: &mut [f64]) -> bool {
         false
     }
