@@ -4,11 +4,15 @@
 use std::sync::Arc;
 
 use approx::assert_relative_eq;
+use hexadyn::control::Command;
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, Robot, RobotModel};
 use hexadyn::hexapod::JOINTS;
 use hexadyn::description::RobotDescription;
-use hexadyn::sim::{finite_difference_jacobian, static_equilibrium, Jacobian, Newmark, NewmarkOptions, StaticOptions, System};
+use hexadyn::robot::simulation::PlantOptions;
+use hexadyn::sim::{finite_difference_jacobian, static_equilibrium, Jacobian, Newmark, NewmarkOptions, Order, StaticOptions, System};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// q_v of the supporting legs and of the lifted ones, q_h of all (m).
 const Q_V_DOWN: f64 = 0.06;
@@ -174,4 +178,117 @@ fn coordinate_counts_of_table_3_5_and_section_4_5() {
     assert_eq!(full.model.coordinate_count(), 96);
     assert_eq!(full.model.mechanics.model.body_count(), 49);
     assert_eq!(robot(FrictionModel::LuGre, |_| {}).model.coordinate_count(), 42);
+}
+
+/// The exact change of the residual when the inputs jump (`System::input_change`, Eq. 3.16) is
+/// the difference of two residual evaluations at the same random (q, q', q''), for digital
+/// voltages without inductance (Eq. 4.4: the joint rows) and with it (Eq. 3.91: the current
+/// rows), for the references of continuous PIDs (Eq. 3.97) and on the stand. The commanded
+/// voltages reach twice the supply (saturated) and the joints go beyond the ends of their
+/// strokes (cut by the limit switches when pushed further out).
+#[test]
+fn input_change_is_the_difference_of_two_residuals() {
+    let pid = JointControl::ContinuousPid { t_d: 0.01, n: 10.0, omega_0: 1000.0 };
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    let (mut saturated, mut cut) = (0, 0);
+    for (friction, inductance, control, stand) in [
+        (FrictionModel::LuGre, false, JointControl::Digital, false),
+        (FrictionModel::DryViscous, false, JointControl::Digital, true),
+        (FrictionModel::LuGre, true, JointControl::Digital, false),
+        (FrictionModel::None, false, pid, false),
+        (FrictionModel::LuGre, true, pid, true),
+    ] {
+        let mut r = robot(friction, |o| {
+            o.inductance = inductance;
+            o.control = control;
+            o.stand = stand;
+        });
+        let supply = r.model.options.supply_voltage;
+        let n = r.model.coordinate_count();
+        let (mut f_previous, mut f, mut df) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        for _ in 0..20 {
+            let mut q = r.model.touching_ground(&joints(&[0, 1, 2, 3, 4, 5]));
+            q[2] -= rng.random_range(0.0..2e-3);
+            for k in 0..JOINTS {
+                let stroke = &r.model.strokes[k % 3];
+                let margin = 0.2 * (stroke.end() - stroke.start());
+                q[6 + k] = rng.random_range(stroke.start() - margin..stroke.end() + margin);
+            }
+            let size = |i: usize| if i < 24 { 1e-2 } else { 100.0 * r.layout().scales[i] };
+            let qd: Vec<f64> = (0..n).map(|i| size(i) * rng.random_range(-1.0..1.0)).collect();
+            let qdd: Vec<f64> = (0..n).map(|i| 10.0 * size(i) * rng.random_range(-1.0..1.0)).collect();
+            let command = |rng: &mut ChaCha8Rng| Command {
+                voltages: std::array::from_fn(|_| rng.random_range(-2.0..2.0) * supply),
+                references: std::array::from_fn(|k| q[6 + k] + rng.random_range(-0.01..0.01)),
+            };
+            let (first, second) = (command(&mut rng), command(&mut rng));
+            r.command(&first, &q);
+            let previous: Vec<f64> = (0..JOINTS).map(|k| r.input(k)).collect();
+            r.residual(0.0, &q, &qd, &qdd, &mut f_previous);
+            r.command(&second, &q);
+            r.residual(0.0, &q, &qd, &qdd, &mut f);
+            assert!(r.input_change(0.0, &q, &qd, &qdd, &previous, &mut df));
+            for i in 0..n {
+                let difference = f[i] - f_previous[i];
+                let tol = 1e-12 * (f[i].abs() + f_previous[i].abs()) + 1e-12;
+                assert!((df[i] - difference).abs() <= tol, "{friction:?} inductance {inductance} {control:?} stand {stand}: row {} Δf {} vs {difference}", r.layout().names[i], df[i]);
+            }
+            assert!(df.iter().any(|x| *x != 0.0), "the inputs jumped: Δf is not zero");
+            if control == JointControl::Digital {
+                saturated += second.voltages.iter().filter(|u| u.abs() > supply).count();
+                cut += (0..JOINTS).filter(|&k| second.voltages[k] != 0.0 && r.voltages[k] == 0.0).count();
+            }
+        }
+        let zeros = vec![0.0; n];
+        assert!(!r.input_change(0.0, &zeros, &zeros, &zeros, &[0.0; 3], &mut df), "inputs of the wrong length");
+        assert!(!r.input_change(0.0, &zeros, &zeros, &zeros, &[0.0; JOINTS], &mut [0.0; 3]), "Δf of the wrong length");
+    }
+    assert!(saturated > 100 && cut > 20, "saturated voltages {saturated}, cut by the limit switches {cut}");
+}
+
+/// At every 10 ms control instant of a second of the LuGre robot driven by jumping voltages,
+/// the reset started from the jump of q'' that compensates the exact Δf
+/// (`Newmark::reset_accelerations_after_input_jump`) gives the q'' of a Newton reset from a fresh
+/// mass matrix (a new integrator at the same (t, q, q')) within twice the Newton test of the steps
+/// (1 % of q'' plus newton_tolerance · tolerance · scale / (β h²), or / (γ h) for a first-order
+/// state), where the q'' held from the last step is off by more than 100 times that, and needs on
+/// average fewer than 1.5 residual evaluations where the Newton reset from the held q'' needs two.
+#[test]
+fn reset_after_an_input_jump_matches_the_newton_reset() {
+    let mut r = robot(FrictionModel::LuGre, |_| {});
+    let d = RobotDescription::amru5();
+    let options = PlantOptions::from_description(&d, &r.model.options).integrator;
+    let q = settle(&mut r, &[0, 1, 2, 3, 4, 5]);
+    let qd = vec![0.0; q.len()];
+    let mut nm = Newmark::new(&mut r, 0.0, &q, &qd, options.clone()).unwrap();
+    let layout = r.layout().clone();
+    let h = options.h_max;
+    let floor = |i: usize| {
+        let unit = if layout.orders[i] == Order::Second { options.beta * h * h } else { options.gamma * h };
+        options.newton_tolerance * options.tolerance * layout.scales[i] / unit
+    };
+    let (mut evaluations, mut largest, mut stale) = (0, 0.0_f64, 0.0_f64);
+    let instants = 100;
+    for k in 1..=instants {
+        nm.advance_to(&mut r, 0.01 * k as f64).unwrap();
+        let previous = r.voltages;
+        r.voltages = std::array::from_fn(|j| 4.0 * (0.7 * k as f64 + j as f64).sin());
+        let held = nm.state().qdd.clone();
+        let before = nm.stats().residual_evaluations;
+        nm.reset_accelerations_after_input_jump(&mut r, &previous).unwrap();
+        evaluations += nm.stats().residual_evaluations - before;
+        let s = nm.state();
+        let newton = Newmark::new(&mut r.clone(), s.t, s.q.as_slice(), s.qd.as_slice(), options.clone()).unwrap();
+        let reference = &newton.state().qdd;
+        for i in 0..q.len() {
+            let allowed = 2.0 * (options.newton_tolerance * reference[i].abs() + floor(i));
+            largest = largest.max((s.qdd[i] - reference[i]).abs() / allowed);
+            stale = stale.max((held[i] - reference[i]).abs() / allowed);
+        }
+    }
+    let per_reset = evaluations as f64 / instants as f64;
+    eprintln!("reset after an input jump: {per_reset:.2} residual evaluations each, largest difference {largest:.2e} of twice the Newton test (q'' before the reset: {stale:.2e})");
+    assert!(stale > 100.0, "the voltage jumps move q'' by {stale} times twice the Newton test only");
+    assert!(largest <= 1.0, "q'' off the Newton reset by {largest} times twice the Newton test");
+    assert!(per_reset < 1.5, "{per_reset} residual evaluations per reset");
 }

@@ -171,6 +171,30 @@ fn step_inputs_are_held_between_calls() {
     assert!(err < 2e-5, "max error {err}");
 }
 
+/// A system that does not write the change of its residual (`System::input_change` returns
+/// false, the default) gets the plain Newton reset from `reset_accelerations_after_input_jump`:
+/// the same q'' with the same residual evaluations, on the lag above after u jumps 0 → 1 at
+/// t = 0.5, and q'' = (u − y)/τ to 1e-12.
+#[test]
+fn reset_after_an_input_jump_falls_back_to_the_newton_reset() {
+    let tau = 0.2;
+    let run = |after_jump: bool| {
+        let mut sys = Linear::first_order_lag(tau, 1.0);
+        let mut nm = Newmark::new(&mut sys, 0.0, &[0.0], &[0.0], NewmarkOptions { tolerance: 1e-8, h_max: 0.02, ..Default::default() }).unwrap();
+        nm.advance_to(&mut sys, 0.5).unwrap();
+        sys.set_input(0, 1.0);
+        if after_jump {
+            nm.reset_accelerations_after_input_jump(&mut sys, &[0.0]).unwrap();
+        } else {
+            nm.reset_accelerations(&mut sys).unwrap();
+        }
+        (nm.state().qdd[0], nm.state().qd[0], nm.stats().residual_evaluations)
+    };
+    let (qdd, y, evaluations) = run(true);
+    assert_eq!((qdd, y, evaluations), run(false));
+    assert!((qdd - (1.0 - y) / tau).abs() < 1e-12, "q'' {qdd} vs {}", (1.0 - y) / tau);
+}
+
 /// Without `reset_accelerations` after an input jump, the first step's Newmark formula (Eq. 3.8)
 /// mixes the stale q''(t) with the new q''(t+h): the error estimate of Eq. 3.15 sees the jump and
 /// rejects steps, and the result is less accurate than with the reset. Same lag and input step as

@@ -118,23 +118,29 @@ impl GroundContact {
         if f_n > 0.0 {
             // ∂F_n/∂δ and ∂F_n/∂(dδ/dt); ∂δ/∂p = ∂(dδ/dt)/∂v = ∇δᵀ, ∂(dδ/dt)/∂p = vᵀ ∂∇δ/∂p.
             let dfn_ddelta = self.p_k * spring / delta + self.p_d * damping / delta * delta_rate;
-            let dfn_dp = dfn_ddelta * grad.transpose() + damping * (v.transpose() * hessian);
+            let mut dfn_dp = dfn_ddelta * grad.transpose();
+            if hessian != Matrix3::zeros() {
+                dfn_dp += damping * (v.transpose() * hessian);
+            }
             let dfn_dv = damping * grad.transpose();
-            // ∂v_g/∂p = -(∂n/∂p (n · v) + n vᵀ ∂n/∂p).
-            let dslip_dp = -(dn_dp * n.dot(v) + n * (v.transpose() * dn_dp));
+            // F_t = F_n t(v_g): ∂F_t/∂F_n = t and ∂F_t/∂v_g.
             let speed = slip.norm();
-            let (friction, dft_dp, dft_dv) = if speed < self.v_glim {
+            let (direction, slip_gain) = if speed < self.v_glim {
                 let c = self.mu / self.v_glim;
-                (-c * f_n * slip, -c * (slip * dfn_dp + f_n * dslip_dp), -c * (slip * dfn_dv + f_n * projector))
+                (-c * slip, Matrix3::identity() * (-c * f_n))
             } else {
                 let u = slip / speed;
-                let turn = (Matrix3::identity() - u * u.transpose()) * (f_n / speed);
-                (-self.mu * f_n * u, -self.mu * (u * dfn_dp + turn * dslip_dp), -self.mu * (u * dfn_dv + turn * projector))
+                (-self.mu * u, (Matrix3::identity() - u * u.transpose()) * (-self.mu * f_n / speed))
             };
             out.normal_force = f_n;
-            out.force = f_n * n + friction;
-            out.df_dp = n * dfn_dp + f_n * dn_dp + dft_dp;
-            out.df_dv = n * dfn_dv + dft_dv;
+            out.force = f_n * (n + direction);
+            out.df_dp = (n + direction) * dfn_dp;
+            out.df_dv = (n + direction) * dfn_dv + slip_gain * projector;
+            if dn_dp != Matrix3::zeros() {
+                // The turning normal: F_n ∂n/∂p, and ∂v_g/∂p = -(∂n/∂p (n · v) + n vᵀ ∂n/∂p).
+                let dslip_dp = -(dn_dp * n.dot(v) + n * (v.transpose() * dn_dp));
+                out.df_dp += f_n * dn_dp + slip_gain * dslip_dp;
+            }
         }
         out.absorbed_power = -out.force.dot(v);
         out.dissipated_power = out.absorbed_power - spring * delta_rate;

@@ -693,6 +693,38 @@ impl System for Robot {
             Some(_) => self.references[k] = value,
         }
     }
+
+    /// The inputs enter only the rows of their own joint, affinely, at fixed (q, q', q''):
+    /// a voltage (saturated at the supply; the limit switches were applied when it was
+    /// commanded, [`Robot::command`]) through the current of Eq. 4.4 into the joint row
+    /// (f_j contains −n k_t i) or, with inductance, into the current row of Eq. 3.91 (−u); a
+    /// reference q_d of a continuous PID through its error ε = q_d − q_j into the integral row
+    /// of Eq. 3.97.
+    fn input_change(&mut self, _t: f64, _q: &[f64], qd: &[f64], qdd: &[f64], previous: &[f64], df: &mut [f64]) -> bool {
+        if previous.len() != JOINTS || df.len() != self.model.layout.len() {
+            return false;
+        }
+        df.fill(0.0);
+        let m = &*self.model;
+        for k in 0..JOINTS {
+            let j = 6 + k;
+            match (m.pid, &m.pids) {
+                (Some(p), Some(pids)) => {
+                    let i = p + 2 * k + 1;
+                    df[i] = pids[k].integral_residual(qd[i], qdd[i], 0.0).df_depsilon * (self.references[k] - previous[k]);
+                }
+                _ => {
+                    let motor = &m.motors[k];
+                    let du = saturate(self.voltages[k], m.options.supply_voltage) - saturate(previous[k], m.options.supply_voltage);
+                    match m.currents {
+                        Some(c) => df[c + k] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], 0.0).df_du * du,
+                        None => df[j] = -motor.joint_torque(motor.current(qd[j], 0.0).di_du * du).0,
+                    }
+                }
+            }
+        }
+        true
+    }
 }
 
 /// Number of body coordinates (X, Y, Z, yaw, pitch, roll), first in q.

@@ -12,7 +12,7 @@ use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant
 use crate::hexapod::JOINTS;
 use crate::mbs;
 use crate::physics::{CurrentSensing, CurrentSensors, JointFriction};
-use crate::sim::{Newmark, NewmarkOptions, SimError, State};
+use crate::sim::{Newmark, NewmarkOptions, SimError, State, System};
 
 /// Energies (J) accumulated since the start, by trapezoidal integration of the powers at the
 /// accepted integration steps, and the stored energies at the current state.
@@ -147,6 +147,9 @@ pub struct SimulatedRobot {
     pub energy: EnergyAccount,
     /// The energy account at the start, for balances.
     pub initial_energy: EnergyAccount,
+    /// The inputs (voltages or references) the accelerations of the integrator's state are
+    /// consistent with: those held over the last period, until the next control instant.
+    consistent_inputs: [f64; JOINTS],
     encoders: [Encoder; JOINTS],
     current_sensors: CurrentSensors<JOINTS>,
     period: f64,
@@ -160,7 +163,8 @@ impl SimulatedRobot {
         let integrator = Newmark::new(&mut robot, 0.0, q, qd, options.integrator.clone())?;
         let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: options.encoder_counts, n: robot.model.motors[k].n });
         let current_sensors = CurrentSensors::new(&options.current_sensing, 0.0, &[0.0; JOINTS]);
-        let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), encoders, current_sensors, period: options.period, navigation: options.navigation };
+        let consistent_inputs = std::array::from_fn(|k| robot.input(k));
+        let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), consistent_inputs, encoders, current_sensors, period: options.period, navigation: options.navigation };
         plant.observe();
         plant.current_sensors = CurrentSensors::new(&options.current_sensing, plant.state().t, &plant.robot.outputs.current);
         plant.initial_energy = plant.energy.clone();
@@ -207,7 +211,8 @@ impl Plant for SimulatedRobot {
     fn wait_period(&mut self) -> Result<(), SimError> {
         // The voltages jumped at this instant: make q'' consistent before stepping on, and start
         // the power integration of the period from the powers under the new voltages.
-        self.integrator.reset_accelerations(&mut self.robot)?;
+        self.integrator.reset_accelerations_after_input_jump(&mut self.robot, &self.consistent_inputs)?;
+        self.consistent_inputs = std::array::from_fn(|k| self.robot.input(k));
         self.observe();
         let t_start = self.integrator.state().t;
         // The current jumps with the voltage: the input of the analog filters jumps.

@@ -77,4 +77,15 @@ pub trait System {
     }
     /// Sets input `k` (held constant until changed: zero-order hold).
     fn set_input(&mut self, _k: usize, _value: f64) {}
+
+    /// Writes into `df` the exact change of the residual when the inputs u (Eq. 3.16) jump from
+    /// `previous` to their present values at fixed (t, q, q', q''):
+    /// Δf = f(t, q, q', q''; u) − f(t, q, q', q''; u_previous), and returns true. Where the inputs
+    /// enter f affinely through known functions (a motor voltage through Eq. 4.4, a reference
+    /// through a controller's error) this costs no kinematics, unlike two evaluations of
+    /// [`Self::residual`]. Returns false when the system cannot do it (the default), or when
+    /// `previous` does not hold [`Self::input_count`] values or `df` one per coordinate.
+    fn input_change(&mut self, _t: f64, _q: &[f64], _qd: &[f64], _qdd: &[f64], _previous: &[f64], _df: &mut [f64]) -> bool {
+        false
+    }
 }

@@ -7,7 +7,7 @@ use parry3d_f64::partitioning::BvhNode;
 use parry3d_f64::query::{PointQuery, PointQueryWithLocation, Ray, RayCast};
 use parry3d_f64::shape::{TriMesh, TriMeshFlags, TrianglePointLocation};
 
-use super::{feature_normal_jacobian, Extent, InsideNormal, Proximity, Terrain, Triangles};
+use super::{feature_normal_jacobian, Extent, InsideNormal, Proximity, Terrain, Triangles, INSIDE_BLEND_BAND};
 
 /// Why triangles do not make a terrain mesh.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -130,9 +130,16 @@ impl Terrain for MeshTerrain {
             return self.contact(c, face, point, location, radius, Some(vicinity));
         }
         let (projection, (face, location)) = self.mesh.project_local_point_and_get_location(c, false);
-        // Wide enough for the faces of the inside normal's blend, within twice the distance.
-        vicinity.gather(&self.mesh, c, 2.0 * (projection.point - c).length() + VICINITY_MARGIN);
-        self.contact(c, face, projection.point, location, radius, Some(vicinity))
+        let proximity = self.contact(c, face, projection.point, location, radius, None);
+        // Inside the ground, wide enough for the faces of the normal's blend.
+        let distance = radius - proximity.penetration;
+        let reach = if distance < 0.0 { -(1.0 + INSIDE_BLEND_BAND) * distance } else { distance } + VICINITY_MARGIN;
+        if reach <= VICINITY_MAX_REACH {
+            vicinity.gather(&self.mesh, c, reach);
+        } else {
+            vicinity.clear();
+        }
+        proximity
     }
 
     fn triangles(&self, _extent: Extent) -> Triangles {
@@ -165,7 +172,7 @@ impl MeshTerrain {
                 }
             }
         };
-        let (normal, normal_jacobian) = if distance < 0.0 { self.inside_normal(c, InsideNormal::new(-distance, n, curvature), vicinity) } else { (n, curvature) };
+        let (normal, normal_jacobian) = if distance < 0.0 { self.inside_normal(c, face, InsideNormal::new(-distance, n, curvature), vicinity) } else { (n, curvature) };
         Proximity { penetration: radius - distance, normal, penetration_gradient: -n, penetration_hessian: -curvature, normal_jacobian }
     }
 
@@ -180,17 +187,20 @@ impl MeshTerrain {
         Some(from_parry((to - from).normalize()))
     }
 
-    /// The normal of a foot at `c` inside the ground ([`InsideNormal`]) and its derivative:
-    /// every face within the blend's reach takes part.
-    fn inside_normal(&self, c: PVec, mut blend: InsideNormal, vicinity: Option<&Vicinity>) -> (Vector3<f64>, Matrix3<f64>) {
+    /// The normal of a foot at `c` inside the ground whose closest point is on `closest`
+    /// ([`InsideNormal`]) and its derivative: every face within the blend's reach takes part.
+    fn inside_normal(&self, c: PVec, closest: u32, mut blend: InsideNormal, vicinity: Option<&Vicinity>) -> (Vector3<f64>, Matrix3<f64>) {
         if let Some(reach) = blend.reach() {
+            blend.add_closest(closest, from_parry(self.normals[closest as usize]));
             let mut add = |face: u32| {
-                let d = c - self.mesh.triangle(face).project_local_point(c, false).point;
-                let e = d.length();
-                blend.add(face, from_parry(self.normals[face as usize]), e, from_parry(d / e));
+                if face != closest {
+                    let d = c - self.mesh.triangle(face).project_local_point(c, false).point;
+                    let e = d.length();
+                    blend.add(face, from_parry(self.normals[face as usize]), e, from_parry(d / e));
+                }
             };
             match vicinity {
-                Some(v) if v.holds(c, reach) => v.faces.iter().filter(|(_, aabb)| aabb.distance_to_local_point(c, true) <= reach).for_each(|&(face, _)| add(face)),
+                Some(v) if v.holds(c, reach) => v.faces.iter().filter(|(_, aabb)| box_distance_squared(aabb, c) <= reach * reach).for_each(|&(face, _)| add(face)),
                 _ => self.mesh.bvh().leaves(|node: &BvhNode| node.aabb().distance_to_local_point(c, true) <= reach).for_each(add),
             }
         }
@@ -215,6 +225,17 @@ impl MeshTerrain {
 /// searches of the whole mesh. 1 cm: a tenth of the 10 cm cells of the shipped rough ground,
 /// about what a swinging foot covers in 0.2 s, while a foot on the ground moves micrometres.
 const VICINITY_MARGIN: f64 = 0.01;
+
+/// The widest [`Vicinity`] gathered (m): a foot farther from the ground (a trial state of a
+/// Newton iteration that went astray, a body lifted off) would gather much of the mesh and
+/// every later query would scan it; it keeps none and searches the whole mesh until it comes
+/// back. 25 cm: above the highest swing of the shipped gaits (9 cm) with the margin.
+const VICINITY_MAX_REACH: f64 = 0.25;
+
+/// The squared distance from `c` to a bounding box (0 inside it).
+fn box_distance_squared(aabb: &Aabb, c: PVec) -> f64 {
+    (aabb.mins - c).max(c - aabb.maxs).max(PVec::ZERO).length_squared()
+}
 
 /// The faces of a mesh near one foot, kept from one query to the next
 /// ([`Terrain::proximity_near`]): every face whose bounding box comes within `reach` of `centre`.
@@ -243,8 +264,7 @@ impl Vicinity {
         for (k, (face, aabb)) in self.faces.iter().enumerate() {
             // A face whose box is farther than the closest point so far cannot be closer (the
             // relative slack covers the rounding of both distances).
-            let outside = (aabb.mins - c).max(c - aabb.maxs).max(PVec::ZERO);
-            if outside.length_squared() > best_distance * best_distance * (1.0 + 1e-9) {
+            if box_distance_squared(aabb, c) > best_distance * best_distance * (1.0 + 1e-9) {
                 continue;
             }
             let (projection, location) = mesh.triangle(*face).project_local_point_and_get_location(c, false);
@@ -270,6 +290,12 @@ impl Vicinity {
     fn holds(&self, c: PVec, distance: f64) -> bool {
         // A nanometre of slack for the rounding of the bounding boxes' distances.
         c.distance(self.centre) + distance <= self.reach - 1e-9
+    }
+
+    /// Keeps no face: the next query searches the whole mesh.
+    fn clear(&mut self) {
+        self.reach = 0.0;
+        self.faces.clear();
     }
 
     /// Gathers the faces whose bounding box comes within `reach` of `centre`.

@@ -115,7 +115,7 @@ pub(crate) struct InsideNormal {
     /// The fade to n_c with the depth ([`INSIDE_BLEND_DEPTH`]) and its derivative in the depth.
     fade: (f64, f64),
     /// Distinct normals: (key of the face representing it, unit normal, weight, its gradient).
-    normals: [(u32, Vector3<f64>, f64, Vector3<f64>); 8],
+    normals: [(u32, Vector3<f64>, f64, Vector3<f64>); 6],
     len: usize,
     /// The weighted normals of more distinct faces than `normals` holds (not grouped), and
     /// their derivative ∂/∂p.
@@ -131,7 +131,7 @@ impl InsideNormal {
             depth,
             closest: (closest, closest_jacobian),
             fade: (fade, slope / INSIDE_BLEND_DEPTH),
-            normals: [(0, Vector3::zeros(), 0.0, Vector3::zeros()); 8],
+            normals: [(0, Vector3::zeros(), 0.0, Vector3::zeros()); 6],
             len: 0,
             overflow: (Vector3::zeros(), Matrix3::zeros()),
         }
@@ -141,6 +141,11 @@ impl InsideNormal {
     /// faded out (no face takes part).
     pub(crate) fn reach(&self) -> Option<f64> {
         (self.fade.0 > 0.0).then_some((1.0 + INSIDE_BLEND_BAND) * self.depth)
+    }
+
+    /// The closest face, of key `key` and unit normal `normal`: weight 1, no gradient (u = 0).
+    pub(crate) fn add_closest(&mut self, key: u32, normal: Vector3<f64>) {
+        self.add(key, normal, self.depth, -self.closest.0);
     }
 
     /// The face of key `key` (its index), unit normal `normal`, at `distance` e from the foot,
