@@ -192,9 +192,12 @@ impl MeshTerrain {
     fn inside_normal(&self, c: PVec, closest: u32, mut blend: InsideNormal, vicinity: Option<&Vicinity>) -> (Vector3<f64>, Matrix3<f64>) {
         if let Some(reach) = blend.reach() {
             blend.add_closest(closest, from_parry(self.normals[closest as usize]));
+            // The projections the vicinity made for this query, then new ones.
+            let projected = vicinity.map_or(&[][..], |v| &v.projected[..]);
             let mut add = |face: u32| {
                 if face != closest {
-                    let d = c - self.mesh.triangle(face).project_local_point(c, false).point;
+                    let point = projected.iter().find(|(f, _)| *f == face).map_or_else(|| self.mesh.triangle(face).project_local_point(c, false).point, |&(_, p)| p);
+                    let d = c - point;
                     let e = d.length();
                     blend.add(face, from_parry(self.normals[face as usize]), e, from_parry(d / e));
                 }
@@ -249,6 +252,9 @@ pub struct Vicinity {
     pub(super) reach: f64,
     /// The faces and their bounding boxes, the closest of the last query first.
     faces: Vec<(u32, Aabb)>,
+    /// The faces the last query projected the foot on, and the projections (for the inside
+    /// normal's blend, which needs the same faces' distances).
+    projected: Vec<(u32, PVec)>,
 }
 
 impl Vicinity {
@@ -261,6 +267,7 @@ impl Vicinity {
         // Two faces at exactly the closest distance (the closest point on their common edge):
         // parry3d's search keeps the first it visits, so the vicinity leaves the choice to it.
         let mut tie = false;
+        self.projected.clear();
         for (k, (face, aabb)) in self.faces.iter().enumerate() {
             // A face whose box is farther than the closest point so far cannot be closer (the
             // relative slack covers the rounding of both distances).
@@ -268,6 +275,7 @@ impl Vicinity {
                 continue;
             }
             let (projection, location) = mesh.triangle(*face).project_local_point_and_get_location(c, false);
+            self.projected.push((*face, projection.point));
             let distance = (projection.point - c).length();
             if distance < best_distance {
                 best = Some((k, projection.point, location));
@@ -296,6 +304,7 @@ impl Vicinity {
     fn clear(&mut self) {
         self.reach = 0.0;
         self.faces.clear();
+        self.projected.clear();
     }
 
     /// Gathers the faces whose bounding box comes within `reach` of `centre`.
@@ -303,6 +312,7 @@ impl Vicinity {
         self.centre = centre;
         self.reach = reach;
         self.faces.clear();
+        self.projected.clear();
         let within = |node: &BvhNode| node.aabb().distance_to_local_point(centre, true) <= reach;
         self.faces.extend(mesh.bvh().leaves(within).map(|face| (face, mesh.triangle(face).local_aabb())));
     }
