@@ -25,7 +25,14 @@ impl Default for StaticOptions {
 /// keep their given value; a row whose coordinate is locked is not required to vanish (the
 /// locked coordinate's generalized force is the reaction that holds it). Newton-Raphson on
 /// KT / CT with backtracking on the residual norm.
-pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64], qd: &mut [f64], locked: &[usize], options: &StaticOptions) -> Result<(), SimError> {
+pub fn static_equilibrium<S: System + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    locked: &[usize],
+    options: &StaticOptions,
+) -> Result<(), SimError> {
     let n = q.len();
     let orders = sys.layout().orders.clone();
     let free: Vec<usize> = (0..n).filter(|i| !locked.contains(i)).collect();
@@ -73,6 +80,7 @@ pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64]
         // grows a hundredfold until one does (the step turns towards the gradient and
         // shortens). Past the largest damping the backtracking's last step is taken.
         let scale = (0..k).map(|i| a[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let grow = |damping: f64| if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 };
         let (q0, qd0) = (q.to_vec(), qd.to_vec());
         let mut damping = 0.0;
         loop {
@@ -83,13 +91,14 @@ pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64]
             let dx = match damped.lu().solve(&rhs) {
                 Some(dx) if dx.iter().all(|x| x.is_finite()) => dx,
                 _ if damping < scale => {
-                    damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 };
+                    damping = grow(damping);
                     continue;
                 }
                 _ => return Err(SimError::Singular { what: "static tangent stiffness", t }),
             };
+            // The backtracking's last trial (q, q' and f are at it) and whether it decreased.
             let mut lambda = 1.0;
-            let decreased = loop {
+            let (trial, decreased) = loop {
                 for (c, &j) in free.iter().enumerate() {
                     match orders[j] {
                         Order::Second => q[j] = q0[j] - lambda * dx[c],
@@ -98,21 +107,18 @@ pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64]
                 }
                 let trial = norm(sys, q, qd, &mut f);
                 if trial.is_finite() && trial < current {
-                    current = trial;
-                    break true;
+                    break (trial, true);
                 }
                 if lambda < 1e-4 {
-                    break false;
+                    break (trial, false);
                 }
                 lambda *= 0.5;
             };
             if decreased || damping >= 1e6 * scale {
-                if !decreased {
-                    current = norm(sys, q, qd, &mut f);
-                }
+                current = trial;
                 break;
             }
-            damping = if damping == 0.0 { 1e-9 * scale } else { damping * 100.0 };
+            damping = grow(damping);
         }
     }
     sys.residual(t, q, qd, &qdd, &mut f);

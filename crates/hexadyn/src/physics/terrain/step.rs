@@ -44,6 +44,12 @@ impl Step {
         Vector3::new(self.azimuth.cos(), self.azimuth.sin(), 0.0)
     }
 
+    /// The horizontal unit vector along the edge, u turned a quarter turn about z_0.
+    fn along(&self) -> Vector3<f64> {
+        let u = self.u();
+        Vector3::new(-u.y, u.x, 0.0)
+    }
+
     /// Profile coordinates of p: s across the edge (> 0 on the high side), w above the base.
     fn profile(&self, p: &Vector3<f64>) -> Vector2<f64> {
         Vector2::new(self.u().dot(p) - self.edge, p.z - self.base)
@@ -91,8 +97,7 @@ impl Terrain for Step {
                 if d > 0.0 {
                     let sign = if inside { -1.0 } else { 1.0 };
                     let n = to_space(sign * (q - c) / d);
-                    let edge = Vector3::new(-self.azimuth.sin(), self.azimuth.cos(), 0.0);
-                    (sign * d, n, feature_normal_jacobian(n, Some(edge), sign * d))
+                    (sign * d, n, feature_normal_jacobian(n, Some(self.along()), sign * d))
                 } else {
                     (0.0, to_space(*bisector), Matrix3::zeros())
                 }
@@ -117,8 +122,7 @@ impl Terrain for Step {
     /// A square of the extent's size aligned with the edge: the low part, the face and the high
     /// part where the edge crosses it.
     fn triangles(&self, extent: Extent) -> Triangles {
-        let u = self.u();
-        let t = Vector3::new(-u.y, u.x, 0.0);
+        let (u, t) = (self.u(), self.along());
         let centre = Vector3::new(extent.centre[0], extent.centre[1], 0.0);
         let (sc, tc, w) = (u.dot(&centre) - self.edge, t.dot(&centre), extent.half_width);
         let point = |s: f64, along: f64, z: f64| {
