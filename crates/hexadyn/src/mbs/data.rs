@@ -15,8 +15,6 @@ pub struct Data {
     /// For the bodies whose joint ends with a spin (see [`super::model::CompiledElementary`]):
     /// its axis and angle at this evaluation, which [`Data::pose`] applies to `pose`.
     pub(crate) spin: Vec<Option<(Axis, f64)>>,
-    /// Central inertia tensors in the global frame, R Φ Rᵀ.
-    pub(crate) world_inertia: Vec<Matrix3<f64>>,
     /// ω_i and v_i in the global frame (Eq. 3.26, 3.33).
     pub(crate) omega: Vec<Vector3<f64>>,
     pub(crate) velocity: Vec<Vector3<f64>>,
@@ -70,7 +68,6 @@ impl Data {
                     _ => None,
                 })
                 .collect(),
-            world_inertia: vec![Matrix3::zeros(); nb],
             omega: vec![z; nb],
             velocity: vec![z; nb],
             alpha_bias: vec![z; nb],

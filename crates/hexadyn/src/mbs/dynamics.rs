@@ -37,10 +37,8 @@ pub fn residual(model: &Model, data: &mut Data, qdd: &[f64], f: &mut [f64]) {
     // Resultants over the subtrees, descendants first (a body comes after its reference body).
     for (i, body) in model.bodies.iter().enumerate().rev() {
         let (a, alpha) = data.qdd_acceleration[i];
-        let phi = data.world_inertia[i];
-        let w = data.omega[i];
         let lin = (data.accel_bias[i] + a - model.gravity) * body.mass - data.force[i];
-        let ang = phi * (data.alpha_bias[i] + alpha) + w.cross(&(phi * w)) - data.moment[i];
+        let ang = body.inertia_torque(&data.pose[i].rotation, &data.omega[i], &(data.alpha_bias[i] + alpha)) - data.moment[i];
         let (force, moment) = data.subtree[i];
         let (force, moment) = (force + lin, moment + ang);
         for (k, &c) in body.own.iter().enumerate() {
@@ -96,7 +94,7 @@ pub fn mass_matrix(model: &Model, data: &Data, m: &mut DMatrix<f64>) {
     for column in m.as_mut_slice().chunks_mut(rows).take(n) {
         column[..n].fill(0.0);
     }
-    let mut composite: Vec<Composite> = model.bodies.iter().enumerate().map(|(i, b)| Composite { mass: b.mass, first_moment: Vector3::zeros(), inertia: data.world_inertia[i] }).collect();
+    let mut composite: Vec<Composite> = model.bodies.iter().enumerate().map(|(i, b)| Composite { mass: b.mass, first_moment: Vector3::zeros(), inertia: b.world_inertia(&data.pose[i].rotation) }).collect();
     // Descendants first (a body comes after its reference body).
     for (i, body) in model.bodies.iter().enumerate().rev() {
         if let Some(p) = body.parent {
@@ -143,10 +141,8 @@ pub fn nonlinear_effects(model: &Model, data: &Data) -> Vec<f64> {
     data.assert_complete();
     let mut h = vec![0.0; model.coordinates];
     for (i, body) in model.bodies.iter().enumerate() {
-        let phi = data.world_inertia[i];
-        let w = data.omega[i];
         let lin = data.accel_bias[i] * body.mass;
-        let ang = phi * data.alpha_bias[i] + w.cross(&(phi * w));
+        let ang = body.inertia_torque(&data.pose[i].rotation, &data.omega[i], &data.alpha_bias[i]);
         for (k, &c) in body.columns.iter().enumerate() {
             h[c] += data.d[body.offset + k].dot(&lin) + data.delta[body.offset + k].dot(&ang);
         }
@@ -176,7 +172,7 @@ pub fn kinetic_energy(model: &Model, data: &Data) -> f64 {
         .enumerate()
         .map(|(i, b)| {
             let w = data.omega[i];
-            0.5 * (b.mass * data.velocity[i].norm_squared() + w.dot(&(data.world_inertia[i] * w)))
+            0.5 * b.mass * data.velocity[i].norm_squared() + b.rotational_energy(&data.pose[i].rotation, &w)
         })
         .sum()
 }

@@ -8,7 +8,7 @@
 //! partial velocities ride along rigidly, so they are kept relative to it (and summed into the
 //! full d_ij, δ_ij only when asked for, e.g. for the mass matrix).
 
-use nalgebra::{DMatrix, Matrix3, Vector3};
+use nalgebra::{DMatrix, Vector3};
 
 use super::data::Data;
 use super::dependent;
@@ -61,19 +61,6 @@ fn offset_motion(r: &Vector3<f64>, omega: &Vector3<f64>, alpha: &Vector3<f64>, v
 pub fn kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]) {
     relative_kinematics(model, data, q, qd);
     partial_velocities(model, data);
-}
-
-/// Central inertia tensor in the global frame {Φ_G}_0 = R Φ Rᵀ (Eq. 3.38); with principal
-/// moments φ_k along the body axes, Σ_k φ_k r_k r_kᵀ over the columns r_k of R.
-fn world_inertia(r: &Matrix3<f64>, inertia: &Matrix3<f64>, principal: Option<&Vector3<f64>>) -> Matrix3<f64> {
-    match principal {
-        Some(phi) => {
-            let entry = |a: usize, b: usize| phi.x * r[(a, 0)] * r[(b, 0)] + phi.y * r[(a, 1)] * r[(b, 1)] + phi.z * r[(a, 2)] * r[(b, 2)];
-            let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
-            Matrix3::new(entry(0, 0), xy, xz, xy, entry(1, 1), yz, xz, yz, entry(2, 2))
-        }
-        None => r * inertia * r.transpose(),
-    }
 }
 
 /// Evaluates dependent parameters, then poses, velocities and convective accelerations of all
@@ -163,7 +150,6 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
             offset_motion(&displacement, &omega, &alpha, &mut vel, &mut acc, &mut d[..with_delta], &delta[..with_delta]);
             pose.translation += displacement;
         }
-        data.world_inertia[i] = world_inertia(&pose.rotation, &body.inertia, body.principal.as_ref());
         data.pose[i] = pose;
         data.omega[i] = omega;
         data.velocity[i] = vel;
@@ -239,8 +225,8 @@ pub fn partial_velocities_numerical(model: &Model, data: &mut Data, q: &[f64]) -
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Matrix3;
     use crate::mbs::{mass_matrix, residual, BodyId, BodySpec, Elementary, ModelBuilder, Var};
-    use crate::spatial::yaw_pitch_roll;
 
     /// A free body carrying a chassis on q6 and a rotor on q7 · 50 about its x axis, whose
     /// equatorial moments are `equatorial` (I_e, I_e for a rotor).
@@ -280,20 +266,10 @@ mod tests {
         assert!(a.spin[rotor.0].is_some() && b.spin[rotor.0].is_none());
         assert!((a.pose(rotor).rotation - b.pose(rotor).rotation).amax() < 1e-15);
         assert!((a.point(rotor, &Vector3::new(0.0, 0.02, 0.0)) - b.point(rotor, &Vector3::new(0.0, 0.02, 0.0))).amax() < 1e-15);
-        assert!((a.world_inertia[rotor.0] - b.world_inertia[rotor.0]).amax() < 1e-15);
+        let world_inertia = |model: &Model, data: &Data| model.bodies[rotor.0].world_inertia(&data.pose(rotor).rotation);
+        assert!((world_inertia(&spinning, &a) - world_inertia(&full, &b)).amax() < 1e-15);
         assert!((&ma - &mb).amax() < 1e-12 * mb.amax(), "{}", (&ma - &mb).amax());
         let scale = fb.iter().fold(0.0_f64, |s, x| s.max(x.abs()));
         assert!(fa.iter().zip(&fb).all(|(x, y)| (x - y).abs() < 1e-12 * scale), "{fa:?} vs {fb:?}");
-    }
-
-    /// The principal-moment form of R Φ Rᵀ is the product.
-    #[test]
-    fn world_inertia_from_principal_moments_is_the_product() {
-        let r = yaw_pitch_roll(0.7, -0.4, 1.9);
-        let phi = Vector3::new(0.3, 1.2, 2.5);
-        let inertia = Matrix3::from_diagonal(&phi);
-        let product = r * inertia * r.transpose();
-        assert!((world_inertia(&r, &inertia, Some(&phi)) - product).amax() < 1e-15 * product.amax());
-        assert_eq!(world_inertia(&r, &inertia, None), product);
     }
 }
