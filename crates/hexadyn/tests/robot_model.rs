@@ -247,14 +247,14 @@ fn input_change_is_the_difference_of_two_residuals() {
 }
 
 /// At every 10 ms control instant of a second of the LuGre robot driven by jumping voltages,
-/// the reset after the jump (`Newmark::reset_accelerations_after_input_jump`) changes q'' by the
-/// exact response to the new voltages: the difference between the consistent q'' of two Newton
-/// resets from a fresh mass matrix at the same (t, q, q') (new integrators), one under the new
-/// voltages and one under the previous ones, within twice the Newton test of the steps (1 % of
-/// q'' plus newton_tolerance · tolerance · scale / (β h²), or / (γ h) for a first-order state),
-/// where the jump itself is more than 100 times that; and it evaluates no residual.
+/// the reset started from the jump of q'' that compensates the exact Δf
+/// (`Newmark::reset_accelerations_after_input_jump`) gives the q'' of a Newton reset from a fresh
+/// mass matrix (a new integrator at the same (t, q, q')) within twice the Newton test of the steps
+/// (1 % of q'' plus newton_tolerance · tolerance · scale / (β h²), or / (γ h) for a first-order
+/// state), where the q'' held from the last step is off by more than 100 times that, and needs on
+/// average fewer than 1.5 residual evaluations where the Newton reset from the held q'' needs two.
 #[test]
-fn reset_after_an_input_jump_is_the_exact_response_to_the_jump() {
+fn reset_after_an_input_jump_matches_the_newton_reset() {
     let mut r = robot(FrictionModel::LuGre, |_| {});
     let d = RobotDescription::amru5();
     let options = PlantOptions::from_description(&d, &r.model.options).integrator;
@@ -267,8 +267,9 @@ fn reset_after_an_input_jump_is_the_exact_response_to_the_jump() {
         let unit = if layout.orders[i] == Order::Second { options.beta * h * h } else { options.gamma * h };
         options.newton_tolerance * options.tolerance * layout.scales[i] / unit
     };
-    let (mut evaluations, mut largest, mut jump) = (0, 0.0_f64, 0.0_f64);
-    for k in 1..=100 {
+    let (mut evaluations, mut largest, mut stale) = (0, 0.0_f64, 0.0_f64);
+    let instants = 100;
+    for k in 1..=instants {
         nm.advance_to(&mut r, 0.01 * k as f64).unwrap();
         let previous = r.voltages;
         r.voltages = std::array::from_fn(|j| 4.0 * (0.7 * k as f64 + j as f64).sin());
@@ -277,20 +278,17 @@ fn reset_after_an_input_jump_is_the_exact_response_to_the_jump() {
         nm.reset_accelerations_after_input_jump(&mut r, &previous).unwrap();
         evaluations += nm.stats().residual_evaluations - before;
         let s = nm.state();
-        let consistent = |voltages: [f64; 18]| {
-            let mut fresh = r.clone();
-            fresh.voltages = voltages;
-            Newmark::new(&mut fresh, s.t, s.q.as_slice(), s.qd.as_slice(), options.clone()).unwrap().state().qdd.clone()
-        };
-        let (after, before) = (consistent(r.voltages), consistent(previous));
+        let newton = Newmark::new(&mut r.clone(), s.t, s.q.as_slice(), s.qd.as_slice(), options.clone()).unwrap();
+        let reference = &newton.state().qdd;
         for i in 0..q.len() {
-            let allowed = 2.0 * (options.newton_tolerance * after[i].abs() + floor(i));
-            largest = largest.max(((s.qdd[i] - held[i]) - (after[i] - before[i])).abs() / allowed);
-            jump = jump.max((after[i] - before[i]).abs() / allowed);
+            let allowed = 2.0 * (options.newton_tolerance * reference[i].abs() + floor(i));
+            largest = largest.max((s.qdd[i] - reference[i]).abs() / allowed);
+            stale = stale.max((held[i] - reference[i]).abs() / allowed);
         }
     }
-    eprintln!("reset after an input jump: {evaluations} residual evaluations, largest difference {largest:.2e} of twice the Newton test (the jump: {jump:.2e})");
-    assert!(jump > 100.0, "the voltage jumps move q'' by {jump} times twice the Newton test only");
-    assert!(largest <= 1.0, "q'' off the exact response by {largest} times twice the Newton test");
-    assert_eq!(evaluations, 0, "residual evaluations in the resets");
+    let per_reset = evaluations as f64 / instants as f64;
+    eprintln!("reset after an input jump: {per_reset:.2} residual evaluations each, largest difference {largest:.2e} of twice the Newton test (q'' before the reset: {stale:.2e})");
+    assert!(stale > 100.0, "the voltage jumps move q'' by {stale} times twice the Newton test only");
+    assert!(largest <= 1.0, "q'' off the Newton reset by {largest} times twice the Newton test");
+    assert!(per_reset < 1.5, "{per_reset} residual evaluations per reset");
 }

@@ -436,33 +436,6 @@ impl Robot {
         }
     }
 
-    /// The voltage u (saturated at the supply), current i and joint torque τ_m of the motor of
-    /// joint k at the state's q' under the inputs held now: Eq. 4.4 without inductance, the
-    /// current state of Eq. 3.91 with it; with continuous PID controllers u is their output state.
-    fn motor(m: &RobotModel, voltages: &[f64; JOINTS], k: usize, qd: &[f64]) -> (f64, f64, f64) {
-        let motor = &m.motors[k];
-        let commanded = m.pid.map_or(voltages[k], |p| qd[p + 2 * k]);
-        let u = saturate(commanded, m.options.supply_voltage);
-        let i = match m.currents {
-            Some(c) => qd[c + k],
-            None => motor.current(qd[6 + k], u).i,
-        };
-        (u, i, motor.joint_torque(i).0)
-    }
-
-    /// The outputs after the inputs jumped at a control instant: at fixed (q, q', q'') the inputs
-    /// change only the motors' voltages, currents and torques (see [`System::input_change`]),
-    /// taken here at `qd`; the contact forces, friction torques and bristle deflections stay
-    /// those of the last [`Self::evaluate`] (after a step, its last Newton iterate, within the
-    /// Newton test of the accepted state). No kinematics.
-    pub fn outputs_after_input_jump(&mut self, qd: &[f64]) {
-        for k in 0..JOINTS {
-            let (u, i, tau_m) = Self::motor(&self.model, &self.voltages, k, qd);
-            let out = &mut self.outputs;
-            (out.voltage[k], out.current[k], out.motor_torque[k]) = (u, i, tau_m);
-        }
-    }
-
     /// Kinematics, contact forces and joint torques at (q, q', q''), written into the multibody
     /// workspace and [`Self::outputs`].
     pub fn evaluate(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) {
@@ -489,10 +462,17 @@ impl Robot {
         // Motors (Eq. 3.90-3.92 or 4.4-4.7) and joint friction (Eq. 6.1 or 3.87).
         for k in 0..JOINTS {
             let j = 6 + k;
-            let (u, i, tau_m) = Self::motor(m, &self.voltages, k, qd);
+            let motor = &m.motors[k];
+            let commanded = m.pid.map_or(self.voltages[k], |p| qd[p + 2 * k]);
+            let u = saturate(commanded, m.options.supply_voltage);
+            let i = match m.currents {
+                Some(c) => qd[c + k],
+                None => motor.current(qd[j], u).i,
+            };
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
             let load = out.contact[k / 3].normal_force;
             let tau_f = m.friction[k].torque(qd[j], z, zdot, load).tau;
+            let tau_m = motor.joint_torque(i).0;
             self.data.add_generalized_force(j, tau_m - tau_f);
             out.voltage[k] = u;
             out.current[k] = i;

@@ -210,13 +210,12 @@ impl Plant for SimulatedRobot {
 
     fn wait_period(&mut self) -> Result<(), SimError> {
         // The voltages jumped at this instant: make q'' consistent before stepping on, and start
-        // the power integration of the period from the powers under the new voltages (the
-        // motors' outputs under them, the rest from the last step's last iterate).
+        // the power integration of the period from the powers under the new voltages: the
+        // outputs of the reset's last evaluation, at the state's (q, q') and within the Newton
+        // test of its q'' (the reset evaluates f at least once).
         self.integrator.reset_accelerations_after_input_jump(&mut self.robot, &self.consistent_inputs)?;
         self.consistent_inputs = std::array::from_fn(|k| self.robot.input(k));
-        let s = self.integrator.state();
-        self.robot.outputs_after_input_jump(s.qd.as_slice());
-        self.energy.accumulate(&self.robot, s);
+        self.energy.accumulate(&self.robot, self.integrator.state());
         let t_start = self.integrator.state().t;
         // The current jumps with the voltage: the input of the analog filters jumps.
         self.current_sensors.advance(t_start, &self.robot.outputs.current);

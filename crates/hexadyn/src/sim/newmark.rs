@@ -201,74 +201,28 @@ impl Newmark {
         Ok(())
     }
 
-    /// The consistent accelerations after the inputs jumped from `previous` to the values the
-    /// system holds now (zero-order hold at a control instant). With f affine in q'' and in the
-    /// inputs at fixed (q, q'), the jump of q'' is the exact response to the change of the
-    /// residual, M Δq'' = −Δf (Eq. 3.16 at fixed q, q', with M = ∂f/∂q'' of Eq. 3.39 and Δf from
-    /// [`System::input_change`], no evaluation of f): q'' is changed by Δq'' only, and keeps
-    /// what the last step's Newton iteration made of it.
-    ///
-    /// Re-solving f = 0 at fixed (q, q') instead (the Newton reset, [`Self::reset_accelerations`])
-    /// would also turn the residual the step left within its Newton test, in the metric of the
-    /// iteration matrix J = M + γh CT + βh² KT (Eq. 3.14), into changes of q'' in the metric of M,
-    /// where the stiff terms (ground contact, the LuGre bristle relaxation of Eq. 3.85) are
-    /// absent: on the 75 s LuGre walk that noise in q'' then cost the next steps 6 % more Newton
-    /// iterations and 20 % more rejected steps, besides the reset's own evaluations
-    /// (docs/performance-log.md, session 27).
-    ///
-    /// Δq'' is solved with the kept factorization of M and verified against the mass block of
-    /// the last Jacobian (the freshest M at hand): the correction of M_kept⁻¹ (M Δq'' + Δf) must
-    /// pass the Newton test of the steps; when it does not contract fast, M is factorized afresh
-    /// from that block. Without Δf (the system returns false) or a kept factorization, this is
-    /// the Newton reset.
+    /// [`Self::reset_accelerations`] after the inputs jumped from `previous` to the values the
+    /// system holds now (zero-order hold at a control instant), started from the jump of q''
+    /// that compensates the exact change of the residual: with f affine in q'' at fixed (q, q'),
+    /// M Δq'' = −Δf (Eq. 3.16 at fixed q, q', with M of Eq. 3.39), solved with the kept
+    /// factorization of M and Δf from [`System::input_change`] without evaluating f. The Newton
+    /// iteration of the reset then starts within the error of the kept M and the Newton
+    /// tolerance of the last step: on the 75 s LuGre walk two thirds of the resets pass the
+    /// Newton test at their first evaluation (they all needed two before). The iteration is still
+    /// needed: with a fresh M at every instant, 29 % of the first corrections after the jump
+    /// still fail the test (what the last step's Newton left in the rows of the stiff first-order
+    /// states), and only the iteration detects a kept M gone stale. Without Δf (the system
+    /// returns false) or a kept factorization, this is the plain [`Self::reset_accelerations`].
     pub fn reset_accelerations_after_input_jump<S: System + ?Sized>(&mut self, sys: &mut S, previous: &[f64]) -> Result<(), SimError> {
-        let s = &self.state;
-        let exact = self.mass_lu.is_some() && sys.input_change(s.t, s.q.as_slice(), s.qd.as_slice(), s.qdd.as_slice(), previous, &mut self.work.f) && self.work.f.iter().all(|x| x.is_finite());
-        if !exact {
-            return self.reset_accelerations(sys);
-        }
-        let delta_f = DVector::from_column_slice(&self.work.f);
-        if let Some(jump) = self.acceleration_jump(sys, &delta_f, FAST_CONTRACTION) {
-            self.state.qdd += jump;
-            return Ok(());
-        }
-        if let Some(m) = self.jacobian.as_ref().map(|j| j.m.clone()) {
-            self.mass_lu = Factorization::new(m, &self.first_order(sys));
-            self.stats.factorizations += 1;
-            if let Some(jump) = self.acceleration_jump(sys, &delta_f, 1.0) {
-                self.state.qdd += jump;
-                return Ok(());
+        if let Some(lu) = &self.mass_lu {
+            let s = &self.state;
+            if sys.input_change(s.t, s.q.as_slice(), s.qd.as_slice(), s.qdd.as_slice(), previous, &mut self.work.f) && self.work.f.iter().all(|x| x.is_finite()) {
+                if let Some(dx) = lu.solve(&self.work.f) {
+                    self.state.qdd -= &dx;
+                }
             }
         }
         self.reset_accelerations(sys)
-    }
-
-    /// Δq'' with M Δq'' = −Δf: solved with the kept factorization of M, then refined against the
-    /// mass block of the last Jacobian (when there is one) until the correction passes the
-    /// Newton test of the steps, each correction at least `contraction` times the one before;
-    /// `None` when the kept factorization cannot do it.
-    fn acceleration_jump<S: System + ?Sized>(&mut self, sys: &S, delta_f: &DVector<f64>, contraction: f64) -> Option<DVector<f64>> {
-        self.weights(sys);
-        let lu = self.mass_lu.as_ref()?;
-        let mut jump = -lu.solve(delta_f.as_slice())?;
-        let Some(jacobian) = &self.jacobian else { return Some(jump) };
-        let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, self.h);
-        let mut previous = f64::INFINITY;
-        for _ in 0..self.options.max_iterations {
-            let mut r = delta_f.clone();
-            r.gemv(1.0, &jacobian.m, &jump, 1.0);
-            let dx = lu.solve(r.as_slice())?;
-            jump -= &dx;
-            let norm = test.norm(&dx, &self.work.weight_q);
-            if test.converged(norm, &dx, &(&self.state.qdd + &jump)) {
-                return Some(jump);
-            }
-            if !(norm <= contraction * previous) {
-                return None;
-            }
-            previous = norm;
-        }
-        None
     }
 
     /// Newton iterations q'' ← q'' − M⁻¹ f with the kept factorization of M, until the
