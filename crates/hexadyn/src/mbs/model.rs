@@ -178,17 +178,9 @@ pub(crate) struct Body {
 
 impl Body {
     /// Central inertia tensor in the global frame {Φ_G}_0 = R Φ Rᵀ (Eq. 3.38) for the body axes
-    /// R; with principal moments φ_k along the body axes, Σ_k φ_k r_k r_kᵀ over the columns r_k
-    /// of R.
+    /// R (the mass matrix; the residual takes the inertia torque in the body axes).
     pub(crate) fn world_inertia(&self, r: &Matrix3<f64>) -> Matrix3<f64> {
-        match &self.principal {
-            Some(phi) => {
-                let entry = |a: usize, b: usize| phi.x * r[(a, 0)] * r[(b, 0)] + phi.y * r[(a, 1)] * r[(b, 1)] + phi.z * r[(a, 2)] * r[(b, 2)];
-                let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
-                Matrix3::new(entry(0, 0), xy, xz, xy, entry(1, 1), yz, xz, yz, entry(2, 2))
-            }
-            None => r * self.inertia * r.transpose(),
-        }
+        r * self.inertia * r.transpose()
     }
 
     /// Φ x for x in the body axes.
@@ -203,24 +195,15 @@ impl Body {
     /// and acceleration ω̇ (global frame), taken in the body axes, R (Φ Rᵀω̇ + Rᵀω × Φ Rᵀω):
     /// the tensor R Φ Rᵀ is not formed.
     pub(crate) fn inertia_torque(&self, r: &Matrix3<f64>, omega: &Vector3<f64>, alpha: &Vector3<f64>) -> Vector3<f64> {
-        let (w, a) = (in_body_axes(r, omega), in_body_axes(r, alpha));
-        let torque = self.inertia_times(&a) + w.cross(&self.inertia_times(&w));
-        let [c0, c1, c2] = r.data.0;
-        Vector3::new(c0[0] * torque.x + c1[0] * torque.y + c2[0] * torque.z, c0[1] * torque.x + c1[1] * torque.y + c2[1] * torque.z, c0[2] * torque.x + c1[2] * torque.y + c2[2] * torque.z)
+        let (w, a) = (r.tr_mul(omega), r.tr_mul(alpha));
+        r * (self.inertia_times(&a) + w.cross(&self.inertia_times(&w)))
     }
 
     /// Rotational kinetic energy ½ ω·Φ_G ω for the body axes R (Eq. 3.38), in the body axes.
     pub(crate) fn rotational_energy(&self, r: &Matrix3<f64>, omega: &Vector3<f64>) -> f64 {
-        let w = in_body_axes(r, omega);
+        let w = r.tr_mul(omega);
         0.5 * w.dot(&self.inertia_times(&w))
     }
-}
-
-/// Rᵀ v: a global vector in the axes R.
-fn in_body_axes(r: &Matrix3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
-    let [c0, c1, c2] = r.data.0;
-    let dot = |c: [f64; 3]| c[0] * v.x + c[1] * v.y + c[2] * v.z;
-    Vector3::new(dot(c0), dot(c1), dot(c2))
 }
 
 /// Immutable multibody description (Model/Data split). Cheap to clone: dependent functions
@@ -447,9 +430,8 @@ mod tests {
     use crate::mbs::{BodySpec, Elementary};
     use crate::spatial::yaw_pitch_roll;
 
-    /// The principal-moment form of R Φ Rᵀ is the product, and the inertia torque taken in the
-    /// body axes is Φ_G ω̇ + ω × Φ_G ω with Φ_G = R Φ Rᵀ (and the energy ½ ω·Φ_G ω), for a body
-    /// on its principal axes and for one with products of inertia.
+    /// The inertia torque taken in the body axes is Φ_G ω̇ + ω × Φ_G ω with Φ_G = R Φ Rᵀ (and the
+    /// energy ½ ω·Φ_G ω), for a body on its principal axes and for one with products of inertia.
     #[test]
     fn inertia_in_the_body_axes_is_the_world_tensor() {
         let principal = Matrix3::from_diagonal(&Vector3::new(0.3, 1.2, 2.5));

@@ -39,7 +39,8 @@ fn from_parry(v: PVec) -> Vector3<f64> {
 /// plane tiled by triangles both are the plane's normal, so a foot sliding across the internal
 /// edges feels no jump. Inside the ground it is the blend of the near faces' normals
 /// ([`InsideNormal`], continuous under convex edges and vertices; the module docs). A terrain
-/// is seen from above: faces whose normal points down are turned over; vertical faces keep the file's orientation, which must point out of the ground
+/// is seen from above: faces whose normal points down are turned over; vertical faces keep the
+/// file's orientation, which must point out of the ground
 /// (counter-clockwise seen from outside, as Blender exports). The mesh must cover the ground
 /// the feet reach: beyond its border there is no ground.
 #[derive(Clone)]
