@@ -246,13 +246,16 @@ fn input_change_is_the_difference_of_two_residuals() {
     assert!(saturated > 100 && cut > 20, "saturated voltages {saturated}, cut by the limit switches {cut}");
 }
 
-/// At every 10 ms control instant of a second of the LuGre robot driven by jumping voltages,
-/// the reset started from the jump of q'' that compensates the exact Δf
-/// (`Newmark::reset_accelerations_after_input_jump`) gives the q'' of a Newton reset from a fresh
-/// mass matrix (a new integrator at the same (t, q, q')) within twice the Newton test of the steps
-/// (1 % of q'' plus newton_tolerance · tolerance · scale / (β h²), or / (γ h) for a first-order
-/// state), where the q'' held from the last step is off by more than 100 times that, and needs on
-/// average fewer than 1.5 residual evaluations where the Newton reset from the held q'' needs two.
+/// At every 10 ms control instant of a second of the LuGre robot driven by jumping voltages, the
+/// reset after the jump (`Newmark::reset_accelerations_after_input_jump`) evaluates f once and
+/// gives the rates of the first-order states (bristles, currents) of a Newton reset from a fresh
+/// mass matrix (a new integrator at the same (t, q, q')) within twice the Newton test of the
+/// steps (1 % of q'' plus newton_tolerance · tolerance · scale / (γ h)), and all of q'' (the
+/// joint and body accelerations too, β h² for the unit) at the instants where its correction
+/// passed the test; the q'' held from the last step is off by more than 100 times that. At the
+/// other instants (the second-order coordinates keep the step's accelerations plus the jump) all
+/// of q'' is within 10 times twice the test. The voltages swing over the whole supply (±12 V)
+/// so that both kinds of instant occur.
 #[test]
 fn reset_after_an_input_jump_matches_the_newton_reset() {
     let mut r = robot(FrictionModel::LuGre, |_| {});
@@ -267,28 +270,35 @@ fn reset_after_an_input_jump_matches_the_newton_reset() {
         let unit = if layout.orders[i] == Order::Second { options.beta * h * h } else { options.gamma * h };
         options.newton_tolerance * options.tolerance * layout.scales[i] / unit
     };
-    let (mut evaluations, mut largest, mut stale) = (0, 0.0_f64, 0.0_f64);
+    let amplitude = d.driver.supply_voltage_v;
+    let (mut evaluations, mut first_order, mut stale, mut consistent, mut others) = (0, 0.0_f64, 0.0_f64, 0, 0.0_f64);
     let instants = 100;
     for k in 1..=instants {
         nm.advance_to(&mut r, 0.01 * k as f64).unwrap();
         let previous = r.voltages;
-        r.voltages = std::array::from_fn(|j| 4.0 * (0.7 * k as f64 + j as f64).sin());
         let held = nm.state().qdd.clone();
+        r.voltages = std::array::from_fn(|j| amplitude * (0.7 * k as f64 + j as f64).sin());
         let before = nm.stats().residual_evaluations;
         nm.reset_accelerations_after_input_jump(&mut r, &previous).unwrap();
         evaluations += nm.stats().residual_evaluations - before;
         let s = nm.state();
         let newton = Newmark::new(&mut r.clone(), s.t, s.q.as_slice(), s.qd.as_slice(), options.clone()).unwrap();
         let reference = &newton.state().qdd;
-        for i in 0..q.len() {
-            let allowed = 2.0 * (options.newton_tolerance * reference[i].abs() + floor(i));
-            largest = largest.max((s.qdd[i] - reference[i]).abs() / allowed);
-            stale = stale.max((held[i] - reference[i]).abs() / allowed);
+        let off = |x: &nalgebra::DVector<f64>, i: usize| (x[i] - reference[i]).abs() / (2.0 * (options.newton_tolerance * reference[i].abs() + floor(i)));
+        let first = (0..q.len()).filter(|&i| layout.orders[i] == Order::First);
+        first_order = first.map(|i| off(&s.qdd, i)).fold(first_order, f64::max);
+        stale = (0..q.len()).map(|i| off(&held, i)).fold(stale, f64::max);
+        let largest = (0..q.len()).map(|i| off(&s.qdd, i)).fold(0.0, f64::max);
+        if largest <= 1.0 {
+            consistent += 1;
+        } else {
+            others = others.max(largest);
         }
     }
-    let per_reset = evaluations as f64 / instants as f64;
-    eprintln!("reset after an input jump: {per_reset:.2} residual evaluations each, largest difference {largest:.2e} of twice the Newton test (q'' before the reset: {stale:.2e})");
+    eprintln!("reset after an input jump: {evaluations} residual evaluations over {instants} instants; first-order rates within {first_order:.2e} of twice the Newton test, all of q'' at {consistent} instants and within {others:.2e} of it at the others (q'' before the reset: {stale:.2e})");
+    assert_eq!(evaluations, instants, "one evaluation per reset");
     assert!(stale > 100.0, "the voltage jumps move q'' by {stale} times twice the Newton test only");
-    assert!(largest <= 1.0, "q'' off the Newton reset by {largest} times twice the Newton test");
-    assert!(per_reset < 1.5, "{per_reset} residual evaluations per reset");
+    assert!(first_order <= 1.0, "first-order rates off the Newton reset by {first_order} times twice the Newton test");
+    assert!(consistent >= instants / 2 && consistent < instants, "all of q'' consistent at {consistent} of {instants} instants");
+    assert!(others <= 10.0, "q'' off the Newton reset by {others} times twice the Newton test");
 }

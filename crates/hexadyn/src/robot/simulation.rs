@@ -211,8 +211,8 @@ impl Plant for SimulatedRobot {
     fn wait_period(&mut self) -> Result<(), SimError> {
         // The voltages jumped at this instant: make q'' consistent before stepping on, and start
         // the power integration of the period from the powers under the new voltages: the
-        // outputs of the reset's last evaluation, at the state's (q, q') and within the Newton
-        // test of its q'' (the reset evaluates f at least once).
+        // outputs of the reset's evaluation, at the state's (q, q') and the q'' after the jump
+        // (the reset evaluates f once, then corrects q'').
         self.integrator.reset_accelerations_after_input_jump(&mut self.robot, &self.consistent_inputs)?;
         self.consistent_inputs = std::array::from_fn(|k| self.robot.input(k));
         self.energy.accumulate(&self.robot, self.integrator.state());
