@@ -2,6 +2,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::broyden::Broyden;
 use super::error::largest_rows;
 use super::factorization::Factorization;
 use super::jacobian::mass_matrix;
@@ -113,6 +114,8 @@ pub struct Newmark {
     /// The Jacobian was refreshed since `mass_lu` was factorized: its mass block is the newer M.
     mass_outdated: bool,
     stats: NewmarkStats,
+    /// The steps of the current Newton iteration, for Broyden's update of the kept matrix.
+    broyden: Broyden,
     work: Work,
 }
 
@@ -149,6 +152,7 @@ impl Newmark {
             jacobian_fresh: false,
             mass_lu: None,
             mass_outdated: false,
+            broyden: Broyden::default(),
             stats: NewmarkStats::default(),
             work: Work { f: vec![0.0; n], q: DVector::zeros(n), qd: DVector::zeros(n), qdd: DVector::zeros(n), weight_q: DVector::zeros(n), dx_previous: DVector::zeros(n) },
         };
@@ -410,7 +414,8 @@ impl Newmark {
     }
 
     /// One attempted step of size h: Newton-Raphson on q''(t+h) (Eq. 3.10) with the iteration
-    /// matrix of Eq. 3.14, then the error estimate of Eq. 3.15.
+    /// matrix of Eq. 3.14 kept from step to step and updated by Broyden within the step
+    /// (`broyden.rs`), then the error estimate of Eq. 3.15.
     fn step<S: System + ?Sized>(&mut self, sys: &mut S, h: f64) -> Result<StepOutcome, SimError> {
         let t_new = self.state.t + h;
         self.weights(sys);
@@ -426,6 +431,7 @@ impl Newmark {
                 self.factorize(sys, h)?;
             }
             let mut previous = f64::INFINITY;
+            self.broyden.clear();
             for iteration in 0..self.options.max_iterations {
                 self.update_kinematics(h);
                 sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
@@ -435,7 +441,10 @@ impl Newmark {
                     break;
                 }
                 let (lu, _) = self.lu.as_ref().expect("factorized");
-                let Some(dx) = lu.solve(&self.work.f) else { break };
+                let Some(newton) = lu.solve(&self.work.f) else { break };
+                // The correction of q'' with the Broyden-updated matrix (`broyden.rs`).
+                let weight = &self.work.weight_q;
+                let dx = -self.broyden.step(-newton, |a, b| test.dot(a, b, weight));
                 self.work.qdd -= &dx;
                 let norm = test.norm(&dx, &self.work.weight_q);
                 if !norm.is_finite() {
@@ -453,6 +462,7 @@ impl Newmark {
                     // it. Go to the middle of the last correction rather than to its end. Only
                     // the path of the iteration changes: the step is accepted by the same test.
                     self.work.qdd.axpy(0.5, &dx, 1.0);
+                    self.broyden.clear();
                 }
                 self.work.dx_previous.copy_from(&dx);
                 if iteration > 0 && contraction > self.options.slow_contraction && !self.jacobian_fresh {
@@ -460,6 +470,7 @@ impl Newmark {
                     // go on from it.
                     self.refresh_jacobian(sys, t_new);
                     self.factorize(sys, h)?;
+                    self.broyden.clear();
                     previous = f64::INFINITY;
                     continue;
                 }
