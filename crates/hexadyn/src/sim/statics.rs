@@ -25,7 +25,14 @@ impl Default for StaticOptions {
 /// keep their given value; a row whose coordinate is locked is not required to vanish (the
 /// locked coordinate's generalized force is the reaction that holds it). Newton-Raphson on
 /// KT / CT with backtracking on the residual norm.
-pub fn static_equilibrium<S: System + ?Sized>(sys: &mut S, t: f64, q: &mut [f64], qd: &mut [f64], locked: &[usize], options: &StaticOptions) -> Result<(), SimError> {
+pub fn static_equilibrium<S: System + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    q: &mut [f64],
+    qd: &mut [f64],
+    locked: &[usize],
+    options: &StaticOptions,
+) -> Result<(), SimError> {
     let n = q.len();
     let orders = sys.layout().orders.clone();
     let free: Vec<usize> = (0..n).filter(|i| !locked.contains(i)).collect();

@@ -293,7 +293,10 @@ fn plane_proximity(plane: &dyn Terrain, p: &Vector3<f64>, radius: f64) -> Proxim
 fn plane_triangles(plane: &dyn Terrain, extent: Extent) -> Triangles {
     let ([cx, cy], w) = (extent.centre, extent.half_width);
     let corner = |x: f64, y: f64| [x, y, plane.height_normal(x, y).0];
-    Triangles { vertices: vec![corner(cx - w, cy - w), corner(cx + w, cy - w), corner(cx + w, cy + w), corner(cx - w, cy + w)], faces: vec![[0, 1, 2], [0, 2, 3]] }
+    Triangles {
+        vertices: vec![corner(cx - w, cy - w), corner(cx + w, cy - w), corner(cx + w, cy + w), corner(cx - w, cy + w)],
+        faces: vec![[0, 1, 2], [0, 2, 3]],
+    }
 }
 
 #[cfg(test)]

@@ -215,9 +215,7 @@ fn analytic_step_matches_its_mesh() {
         for _ in 0..500 {
             let u = Vector3::new(step.azimuth.cos(), step.azimuth.sin(), 0.0);
             // Points near the edge, well inside the meshed square.
-            let p = u * (step.edge + r.random_range(-0.2..0.2))
-                + Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0)
-                + Vector3::new(0.0, 0.0, step.base + r.random_range(-0.05..step.rise + 0.05));
+            let p = u * (step.edge + r.random_range(-0.2..0.2)) + Vector3::new(-u.y, u.x, 0.0) * r.random_range(-1.0..1.0) + Vector3::new(0.0, 0.0, step.base + r.random_range(-0.05..step.rise + 0.05));
             let radius = r.random_range(0.0..0.03);
             let (a, b) = (step.proximity(&p, radius), mesh.proximity(&p, radius));
             assert!((a.penetration - b.penetration).abs() < 1e-9, "{step:?} at {p:?}: δ = {} vs mesh {}", a.penetration, b.penetration);
