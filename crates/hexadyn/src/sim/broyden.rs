@@ -22,7 +22,8 @@ use nalgebra::DVector;
 /// the one of the plain product: the history is dropped and the step of B_0 is taken.
 const RESTART_BELOW: f64 = 0.1;
 
-/// The steps s_0 … s_n taken since the iteration matrix B_0 was last factorized.
+/// The steps s_0 … s_n of the current iteration, taken since it last restarted from B_0 (the
+/// matrix factorized, a new step attempt, a halved correction, or a singular update).
 #[derive(Debug, Default)]
 pub(crate) struct Broyden {
     steps: Vec<DVector<f64>>,
@@ -37,7 +38,8 @@ impl Broyden {
     /// The next step s_{n+1} = −B_{n+1}⁻¹ f from the step of B_0, `newton` = −B_0⁻¹ f
     /// (Kelley's `brsol`: z = newton, z ← z + s_{j+1} ⟨s_j, z⟩/⟨s_j, s_j⟩ for j < n, then
     /// s_{n+1} = z / (1 − ⟨s_n, z⟩/⟨s_n, s_n⟩)), with the inner product `dot`. The step is
-    /// remembered for the next one.
+    /// remembered for the next one. The formulas are odd in the steps: given the corrections
+    /// B_0⁻¹ f throughout, it returns the corrections B_{n+1}⁻¹ f.
     pub(crate) fn step(&mut self, newton: DVector<f64>, dot: impl Fn(&DVector<f64>, &DVector<f64>) -> f64) -> DVector<f64> {
         let step = match self.steps.split_last() {
             None => newton,

@@ -374,6 +374,8 @@ impl Newmark {
             return Err(SimError::Singular { what: "Newmark iteration", t: self.state.t });
         };
         self.lu = Some((lu, h));
+        // Broyden's steps updated the previous matrix.
+        self.broyden.clear();
         Ok(())
     }
 
@@ -442,9 +444,10 @@ impl Newmark {
                 }
                 let (lu, _) = self.lu.as_ref().expect("factorized");
                 let Some(newton) = lu.solve(&self.work.f) else { break };
-                // The correction of q'' with the Broyden-updated matrix (`broyden.rs`).
+                // The correction of q'' with the Broyden-updated matrix (`broyden.rs`; its product
+                // form is odd in the steps, so it takes the corrections dx = −s as they are).
                 let weight = &self.work.weight_q;
-                let dx = -self.broyden.step(-newton, |a, b| test.dot(a, b, weight));
+                let dx = self.broyden.step(newton, |a, b| test.dot(a, b, weight));
                 self.work.qdd -= &dx;
                 let norm = test.norm(&dx, &self.work.weight_q);
                 if !norm.is_finite() {
@@ -470,7 +473,6 @@ impl Newmark {
                     // go on from it.
                     self.refresh_jacobian(sys, t_new);
                     self.factorize(sys, h)?;
-                    self.broyden.clear();
                     previous = f64::INFINITY;
                     continue;
                 }
