@@ -6,7 +6,8 @@
 //! work, against the baseline measured in the same run: the thesis' own figure, 75 s of walking
 //! in 260 s (Table 3.2), scaled to the simulated duration. The physics figures (energy balance,
 //! tracking and walking errors) are printed alongside so that a speed-up that changes them shows.
-//! `walk [case]` runs only the case of that index (0, 1, 2), e.g. under a profiler.
+//! The last two cases repeat the first two with the opt-in surrogate iterations of the integrator.
+//! `walk [case]` runs only the case of that index (0 to 4), e.g. under a profiler.
 
 use std::path::Path;
 
@@ -15,24 +16,26 @@ use hexadyn::scenario::{run_scenario, Scenario};
 const THESIS_WALL_S: f64 = 260.0;
 const THESIS_SIMULATED_S: f64 = 75.0;
 
-fn scenario(file: &str, friction: &str, load_dependence: bool) -> Scenario {
+fn scenario(file: &str, friction: &str, load_dependence: bool, surrogate_iterations: usize) -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../python/hexadyn/scenarios").join(file);
     let text = std::fs::read_to_string(&path).expect("shipped scenario");
     let model = format!("[model]\nfriction = \"{friction}\"\nload_dependence = {load_dependence}\n");
-    let text = text.replace("[model]\nfriction = \"lugre\"\n", &model);
+    let text = text.replace("[model]\nfriction = \"lugre\"\n", &model) + &format!("\n[integrator]\nsurrogate_iterations = {surrogate_iterations}\n");
     Scenario::from_str(&text, &path.display().to_string(), path.parent().expect("scenario folder")).expect("valid scenario")
 }
 
 fn main() {
     let cases = [
-        ("Section 3.4.1: T = 15 s, 2 cm/s, 75 s", scenario("simulation_time.toml", "lugre", false)),
-        ("Table 6.2 1.5 cm/s, 60 s, dry/viscous", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false)),
-        ("  same, load-dependent (Eq. 5.12)", scenario("validation_tripod_1_5cm.toml", "dry_viscous", true)),
+        ("Section 3.4.1: T = 15 s, 2 cm/s, 75 s", scenario("simulation_time.toml", "lugre", false, 0)),
+        ("Table 6.2 1.5 cm/s, 60 s, dry/viscous", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false, 0)),
+        ("  same, load-dependent (Eq. 5.12)", scenario("validation_tripod_1_5cm.toml", "dry_viscous", true, 0)),
+        ("3.4.1, surrogate_iterations = 8", scenario("simulation_time.toml", "lugre", false, 8)),
+        ("6.2 dry/viscous, surrogate_iterations = 8", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false, 8)),
     ];
     println!("hexadyn walk benchmark: tripod walks end to end (settling, gait controller, recording), single core");
     println!(
-        "{:<38} {:>7} {:>6} {:>9} {:>6} {:>5} {:>7} {:>7} {:>5} {:>5} {:>9} {:>8} {:>8} {:>9}",
-        "case", "wall s", "RTF", "vs thesis", "steps", "rej.", "Newton", "f eval.", "Jac.", "LU", "energy %", "q_r mrad", "q_v mm", "XY err mm"
+        "{:<38} {:>7} {:>6} {:>9} {:>6} {:>5} {:>7} {:>7} {:>7} {:>5} {:>5} {:>9} {:>8} {:>8} {:>9}",
+        "case", "wall s", "RTF", "vs thesis", "steps", "rej.", "Newton", "f eval.", "surr.", "Jac.", "LU", "energy %", "q_r mrad", "q_v mm", "XY err mm"
     );
     let only: Option<usize> = std::env::args().nth(1).map(|a| a.parse().unwrap());
     for (i, (name, s)) in cases.iter().enumerate() {
@@ -44,7 +47,7 @@ fn main() {
         let tracking = m.max_tracking_error.unwrap_or([f64::NAN; 3]);
         let xy = m.gait.as_ref().map_or(f64::NAN, |g| g.tracking_error_xy_max_m);
         println!(
-            "{:<38} {:>7.3} {:>6.0} {:>8.0}x {:>6} {:>5} {:>7} {:>7} {:>5} {:>5} {:>9.4} {:>8.3} {:>8.4} {:>9.3}",
+            "{:<38} {:>7.3} {:>6.0} {:>8.0}x {:>6} {:>5} {:>7} {:>7} {:>7} {:>5} {:>5} {:>9.4} {:>8.3} {:>8.4} {:>9.3}",
             name,
             wall,
             m.duration_s / wall,
@@ -53,6 +56,7 @@ fn main() {
             m.rejected_steps,
             m.newton_iterations,
             m.residual_evaluations,
+            m.surrogate_evaluations,
             m.jacobian_evaluations,
             m.factorizations,
             100.0 * m.energy_balance_error_relative,

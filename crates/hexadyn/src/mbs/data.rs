@@ -153,6 +153,19 @@ impl Data {
         self.partial_velocities(model, b).map(move |(c, d, delta)| (c, d + delta.cross(&r)))
     }
 
+    /// The partial velocity of a point of body b at global position p (column j of its J_S) as
+    /// the terms of the joints on its path, Eq. 3.24 summed over b and its ancestors a:
+    /// d_pj = Σ_a d^rel_aj + δ^rel_aj × (p − p_a), (coordinate j, term) pairs, a coordinate
+    /// possibly in several (the dependent parameters of a pantograph move several of its links).
+    /// Needs only [`super::relative_kinematics`].
+    pub fn point_partial_velocity_terms<'a>(&'a self, model: &'a Model, b: BodyId, p: Vector3<f64>) -> impl Iterator<Item = (usize, Vector3<f64>)> + 'a {
+        std::iter::successors(Some(b.0), move |&a| model.bodies[a].parent).flat_map(move |a| {
+            let body = &model.bodies[a];
+            let r = p - self.pose[a].translation;
+            body.own.iter().enumerate().map(move |(k, &c)| (c, self.d_rel[body.own_offset + k] + self.delta_rel[body.own_offset + k].cross(&r)))
+        })
+    }
+
     /// The partial velocities of every body are only available after [`super::kinematics`] or
     /// [`super::partial_velocities`] ([`super::relative_kinematics`] leaves them out).
     pub(crate) fn assert_complete(&self) {

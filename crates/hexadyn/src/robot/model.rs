@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, Vector3};
 use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
 use crate::mbs::{self, Data};
-use crate::physics::{ContactForce, GroundContact, Terrain, Vicinity};
+use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
@@ -307,6 +307,40 @@ pub struct Robot {
     inertial: Option<InertialJacobian>,
     /// The ground near each foot, kept between the contact queries of the evaluations.
     vicinity: [Vicinity; 6],
+    /// The foot states of the last evaluation.
+    feet: Option<[Foot; 6]>,
+    /// The base of [`System::surrogate_residual`].
+    surrogate: Option<Surrogate>,
+}
+
+/// What [`System::surrogate_residual`] expands about: an evaluation of the residual (q0, q'0,
+/// q''0, the multibody rows f0) with its foot states, contact forces and joint forces. Between
+/// two Newton iterates of a step q moves by βh² Δq'' and q' by γh Δq'' (Eq. 3.7-3.8), tiny
+/// beside the scales the kinematics change over, but the force laws are stiff and non-smooth
+/// in the same small moves (Hertz contact and its friction's linear zone, Eq. 3.72-3.73; the
+/// LuGre bristles, Eq. 3.85; the dry friction's regularisation, Eq. 6.1).
+#[derive(Clone, Debug)]
+struct Surrogate {
+    q: [f64; DOF],
+    qd: [f64; DOF],
+    qdd: [f64; DOF],
+    f: [f64; DOF],
+    /// Position, velocity and ground proximity of each foot.
+    feet: [Foot; 6],
+    /// Contact force on each foot and joint force τ_m − τ_f of each joint.
+    contact: [Vector3<f64>; 6],
+    joint: [f64; JOINTS],
+    /// The feet's J_foot (3 × 24, Eq. 3.24 for a point), taken at the first surrogate
+    /// evaluation (an evaluation whose Newton correction passes has none).
+    j_foot: Option<[nalgebra::SMatrix<f64, 3, DOF>; 6]>,
+}
+
+/// The state of a foot the contact law is evaluated at (Eq. 3.72-3.73).
+#[derive(Clone, Copy, Debug)]
+struct Foot {
+    position: Vector3<f64>,
+    velocity: Vector3<f64>,
+    proximity: Proximity,
 }
 
 /// ∂/∂q and ∂/∂q' of the multibody rows with the contact forces and joint forces held at their
@@ -343,7 +377,7 @@ impl InertialJacobian {
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
         let data = Data::new(&model.mechanics.model);
-        Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None, vicinity: Default::default() }
+        Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None, vicinity: Default::default(), feet: None, surrogate: None }
     }
 
     /// The multibody workspace: kinematics and applied forces of the last evaluation.
@@ -442,22 +476,41 @@ impl Robot {
         self.kinematics(q, qd);
         let m = &*self.model;
         let mech = &m.mechanics;
+        let feet: [Foot; 6] = std::array::from_fn(|leg| {
+            let link = mech.legs[leg].links[3];
+            let position = self.data.point(link, &mech.foot_local);
+            let velocity = self.data.point_velocity(link, &position);
+            let proximity = m.terrain.proximity_near(&position, m.options.ground.foot_radius, &mut self.vicinity[leg]);
+            Foot { position, velocity, proximity }
+        });
+        self.force_laws(qd, qdd, &feet);
+        self.feet = Some(feet);
         self.data.clear_forces();
+        let mech = &self.model.mechanics;
+        for (leg, bodies) in mech.legs.iter().enumerate() {
+            let force = self.outputs.contact[leg].force;
+            if force != Vector3::zeros() {
+                self.data.add_force(bodies.links[3], &feet[leg].position, &force);
+            }
+        }
+        for k in 0..JOINTS {
+            self.data.add_generalized_force(6 + k, self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
+        }
+    }
+
+    /// Contact forces at the feet and motor and friction torques of the joints at the given foot
+    /// states and (q', q''), into [`Self::outputs`].
+    fn force_laws(&mut self, qd: &[f64], qdd: &[f64], feet: &[Foot; 6]) {
+        let m = &*self.model;
         let out = &mut self.outputs;
         // Ground contact at the feet (Eq. 3.72-3.73).
-        for (leg, bodies) in mech.legs.iter().enumerate() {
-            let p = self.data.point(bodies.links[3], &mech.foot_local);
-            let v = self.data.point_velocity(bodies.links[3], &p);
-            let proximity = m.terrain.proximity_near(&p, m.options.ground.foot_radius, &mut self.vicinity[leg]);
-            let mut c = m.options.ground.force_at(proximity, &v);
+        for (leg, foot) in feet.iter().enumerate() {
+            let mut c = m.options.ground.force_at(foot.proximity, &foot.velocity);
             // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v.
             c.force.z += m.options.foot_load[leg];
             c.normal_force += m.options.foot_load[leg];
-            if c.force != Vector3::zeros() {
-                self.data.add_force(bodies.links[3], &p, &c.force);
-            }
             out.contact[leg] = c;
-            out.foot[leg] = p;
+            out.foot[leg] = foot.position;
         }
         // Motors (Eq. 3.90-3.92 or 4.4-4.7) and joint friction (Eq. 6.1 or 3.87).
         for k in 0..JOINTS {
@@ -471,21 +524,70 @@ impl Robot {
             };
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
             let load = out.contact[k / 3].normal_force;
-            let tau_f = m.friction[k].torque(qd[j], z, zdot, load).tau;
-            let tau_m = motor.joint_torque(i).0;
-            self.data.add_generalized_force(j, tau_m - tau_f);
             out.voltage[k] = u;
             out.current[k] = i;
-            out.motor_torque[k] = tau_m;
-            out.friction_torque[k] = tau_f;
+            out.motor_torque[k] = motor.joint_torque(i).0;
+            out.friction_torque[k] = m.friction[k].torque(qd[j], z, zdot, load).tau;
             out.bristle[k] = z;
         }
     }
 
     fn write_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.evaluate(q, qd, qdd);
+        mbs::residual(&self.model.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
+        self.write_state_rows(q, qd, qdd, f);
+    }
+
+    /// The surrogate of the residual about `base` (see [`System::surrogate_residual`]): the force
+    /// laws exact at the feet moved by J_foot Δq and J_foot Δq' (the ground's proximity to first
+    /// order in the move, the mesh not searched again), the multibody rows
+    /// f0 + M Δq'' − Σ J_footᵀ ΔF − Δτ (Eq. 3.37 with M the kept mass matrix of the Jacobian and
+    /// the kinematics held at the base), the rows of the states exact.
+    fn write_surrogate(&mut self, base: &mut Surrogate, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        let j_foot = *base.j_foot.get_or_insert_with(|| {
+            self.kinematics(&base.q, &base.qd);
+            let mech = &self.model.mechanics;
+            std::array::from_fn(|leg| {
+                let mut j = nalgebra::SMatrix::<f64, 3, DOF>::zeros();
+                for (col, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
+                    let mut column = j.column_mut(col);
+                    column += d;
+                }
+                j
+            })
+        });
+        let change = |x: &[f64], x0: &[f64; DOF]| nalgebra::SVector::<f64, DOF>::from_fn(|i, _| x[i] - x0[i]);
+        let (dq, dqd, dqdd) = (change(q, &base.q), change(qd, &base.qd), change(qdd, &base.qdd));
+        let feet: [Foot; 6] = std::array::from_fn(|leg| {
+            let Foot { position, velocity, proximity: p } = base.feet[leg];
+            let dp = j_foot[leg] * dq;
+            let proximity = Proximity {
+                penetration: p.penetration + p.penetration_gradient.dot(&dp),
+                normal: p.normal + p.normal_jacobian * dp,
+                penetration_gradient: p.penetration_gradient + p.penetration_hessian * dp,
+                ..p
+            };
+            Foot { position: position + dp, velocity: velocity + j_foot[leg] * dqd, proximity }
+        });
+        self.force_laws(qd, qdd, &feet);
+        let mut rows = nalgebra::SVector::<f64, DOF>::from_column_slice(&base.f);
+        if let Some(inertial) = &self.inertial {
+            rows.gemv(1.0, &inertial.mass, &dqdd, 1.0);
+        }
+        for (leg, j) in j_foot.iter().enumerate() {
+            rows.gemv_tr(-1.0, j, &(self.outputs.contact[leg].force - base.contact[leg]), 1.0);
+        }
+        for k in 0..JOINTS {
+            rows[6 + k] -= self.outputs.motor_torque[k] - self.outputs.friction_torque[k] - base.joint[k];
+        }
+        f[..DOF].copy_from_slice(rows.as_slice());
+        self.write_state_rows(q, qd, qdd, f);
+    }
+
+    /// The rows after the multibody ones: bristles (Eq. 3.85), currents (Eq. 3.91), continuous
+    /// controllers (Eq. 3.96-3.97), from [`Self::outputs`]; the held body's on a stand.
+    fn write_state_rows(&self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         let m = &*self.model;
-        mbs::residual(&m.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
         if m.options.stand {
             f[..BODY].copy_from_slice(&qdd[..BODY]);
         }
@@ -551,6 +653,36 @@ impl System for Robot {
 
     fn residual(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.write_residual(q, qd, qdd, f);
+    }
+
+    /// Needs the kept mass matrix of a Jacobian (none before the first) and the evaluation at
+    /// (q, q').
+    fn keep_surrogate_base(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &[f64]) -> bool {
+        let evaluated = self.kinematics_at.as_ref().is_some_and(|(q0, qd0)| q0[..] == q[..DOF] && qd0[..] == qd[..DOF]);
+        let (Some(feet), Some(_), true) = (self.feet, &self.inertial, evaluated) else { return false };
+        let o = &self.outputs;
+        let array = |x: &[f64]| -> [f64; DOF] { x[..DOF].try_into().expect("DOF coordinates") };
+        self.surrogate = Some(Surrogate {
+            q: array(q),
+            qd: array(qd),
+            qdd: array(qdd),
+            f: array(f),
+            feet,
+            contact: o.contact.map(|c| c.force),
+            joint: std::array::from_fn(|k| o.motor_torque[k] - o.friction_torque[k]),
+            j_foot: None,
+        });
+        true
+    }
+
+    fn surrogate_residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        match self.surrogate.take() {
+            Some(mut base) => {
+                self.write_surrogate(&mut base, q, qd, qdd, f);
+                self.surrogate = Some(base);
+            }
+            None => self.residual(t, q, qd, qdd, f),
+        }
     }
 
     /// Exact blocks for the columns of the bristle and current states and the mass matrix

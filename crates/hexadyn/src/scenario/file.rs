@@ -117,6 +117,7 @@ impl Default for RawModel {
 struct RawIntegrator {
     tolerance: Option<f64>,
     h_max_s: Option<f64>,
+    surrogate_iterations: Option<usize>,
 }
 
 /// `[initial]`.
@@ -227,6 +228,9 @@ const SUPPLY_MIN_V: f64 = 0.1;
 const TOLERANCE_RANGE: [f64; 2] = [1e-4, 10.0];
 /// `integrator.h_max_s`: the smallest largest step (s).
 const H_MAX_MIN_S: f64 = 1e-5;
+/// `integrator.surrogate_iterations`: at most this many per evaluation of f (the Newton
+/// iterations on f itself are at most 8).
+const SURROGATE_ITERATIONS_MAX: usize = 50;
 
 /// Checks that `v` is a finite number in `[lo, hi]` (`unit` and `why` go into the message).
 fn in_range(c: &Ctx, field: &str, v: f64, [lo, hi]: [f64; 2], unit: &str, why: &str) -> Result<()> {
@@ -327,6 +331,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         c.check(v >= H_MAX_MIN_S && v <= period, "integrator.h_max_s", v, &format!("a step in [{H_MAX_MIN_S}, {period}] s (at most one control period; at least 1e-5 s, so that a control period takes at most 1000 steps)")).map_err(e)?;
         plant.integrator.h_max = v;
         plant.integrator.h_initial = plant.integrator.h_initial.min(v);
+    }
+    if let Some(v) = raw.integrator.surrogate_iterations {
+        c.check(v <= SURROGATE_ITERATIONS_MAX, "integrator.surrogate_iterations", v as f64, &format!("0 (the thesis' Newton iteration on f alone) to {SURROGATE_ITERATIONS_MAX} Newton iterations on the surrogate residual after each evaluation of f"))
+            .map_err(e)?;
+        plant.integrator.surrogate_iterations = v;
     }
 
     // Control mode and the walking set-up: in gait mode the initial joints come from the gait.

@@ -35,6 +35,9 @@ pub struct Summary {
     /// Evaluations of the residual f by the integrator: Newton iterations and consistent
     /// accelerations (those inside a Jacobian evaluation are not counted).
     pub residual_evaluations: u64,
+    /// Evaluations of the surrogate residual of the Newton iterations between two of f
+    /// (`System::surrogate_residual`: the force laws at the feet and joints, no kinematics).
+    pub surrogate_evaluations: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,
     /// Body height Z at the start (after settling and offset).
@@ -95,6 +98,7 @@ impl Summary {
             ("rejected_steps", Count(self.rejected_steps)),
             ("newton_iterations", Count(self.newton_iterations)),
             ("residual_evaluations", Count(self.residual_evaluations)),
+            ("surrogate_evaluations", Count(self.surrogate_evaluations)),
             ("jacobian_evaluations", Count(self.jacobian_evaluations)),
             ("factorizations", Count(self.factorizations)),
             ("initial_body_height_m", Number(self.initial_body_height_m)),
@@ -286,6 +290,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         rejected_steps: n.rejected_steps as u64,
         newton_iterations: n.newton_iterations as u64,
         residual_evaluations: n.residual_evaluations as u64,
+        surrogate_evaluations: n.surrogate_evaluations as u64,
         jacobian_evaluations: n.jacobian_evaluations as u64,
         factorizations: n.factorizations as u64,
         initial_body_height_m: q0[2],

@@ -67,6 +67,21 @@ pub trait System {
         false
     }
 
+    /// Keeps the evaluation of [`Self::residual`] just made at (q, q', q'') with its result `f`
+    /// as the base of [`Self::surrogate_residual`] and returns true; false (the default) when
+    /// the system has no surrogate.
+    fn keep_surrogate_base(&mut self, _q: &[f64], _qd: &[f64], _qdd: &[f64], _f: &[f64]) -> bool {
+        false
+    }
+
+    /// A cheaper approximation of [`Self::residual`] near the kept base, for the Newton
+    /// iterations between two evaluations of f (`Newmark`): its accuracy decides how many
+    /// evaluations a step takes, never the accepted solution, which passes the Newton test on f
+    /// itself. The default is the residual.
+    fn surrogate_residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
+        self.residual(t, q, qd, qdd, f)
+    }
+
     /// Number of inputs u (Eq. 3.16).
     fn input_count(&self) -> usize {
         0
