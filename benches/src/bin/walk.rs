@@ -29,8 +29,8 @@ fn main() {
         ("Section 3.4.1: T = 15 s, 2 cm/s, 75 s", scenario("simulation_time.toml", "lugre", false, 0)),
         ("Table 6.2 1.5 cm/s, 60 s, dry/viscous", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false, 0)),
         ("  same, load-dependent (Eq. 5.12)", scenario("validation_tripod_1_5cm.toml", "dry_viscous", true, 0)),
-        ("3.4.1, surrogate_iterations = 8", scenario("simulation_time.toml", "lugre", false, 8)),
-        ("6.2 dry/viscous, surrogate_iterations = 8", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false, 8)),
+        ("3.4.1 LuGre, surrogate_iter. = 8", scenario("simulation_time.toml", "lugre", false, 8)),
+        ("6.2 dry/viscous, surrogate_iter. = 8", scenario("validation_tripod_1_5cm.toml", "dry_viscous", false, 8)),
     ];
     println!("hexadyn walk benchmark: tripod walks end to end (settling, gait controller, recording), single core");
     println!(
