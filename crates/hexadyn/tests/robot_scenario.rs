@@ -143,6 +143,7 @@ fn surrogate_iterations_are_opt_in() {
     assert_eq!(plain.surrogate_evaluations, 0);
     assert!(surrogate.surrogate_evaluations > 0 && surrogate.residual_evaluations < plain.residual_evaluations, "{} and {} surrogate against {} evaluations", surrogate.residual_evaluations, surrogate.surrogate_evaluations, plain.residual_evaluations);
     let (a, b) = (plain.gait.unwrap(), surrogate.gait.unwrap());
+    eprintln!("distance {} vs {}, XY tracking {} vs {}; evaluations {} vs {} + {}", a.distance_walked_m, b.distance_walked_m, a.tracking_error_xy_max_m, b.tracking_error_xy_max_m, plain.residual_evaluations, surrogate.residual_evaluations, surrogate.surrogate_evaluations);
     assert!((a.distance_walked_m - b.distance_walked_m).abs() < 1e-4 && (a.tracking_error_xy_max_m - b.tracking_error_xy_max_m).abs() < 1e-4, "{a:?} vs {b:?}");
 }
 
