@@ -116,6 +116,47 @@ fn direct_partial_velocities_equal_numerical_derivation() {
     }
 }
 
+/// The partial velocity of a point from the relative ones of the joints on its path
+/// (`Data::point_partial_velocity_terms`, after `relative_kinematics` alone) sums, column by
+/// column, to the one from the bodies' full partial velocities, on the AMRU5's feet, whose
+/// pantograph links share dependent parameters (several terms per column).
+#[test]
+fn point_partial_velocity_terms_sum_to_the_point_partial_velocity() {
+    use hexadyn::description::RobotDescription;
+    use hexadyn::hexapod::{joint_index, Mechanics, MechanicsParameters, DOF};
+    use hexadyn::mbs::{partial_velocities, relative_kinematics};
+    let mech = Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap();
+    let model = &mech.model;
+    let mut q = [0.0; DOF];
+    q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
+    for leg in 0..6 {
+        q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
+        q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
+        q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
+    }
+    let mut data = Data::new(model);
+    relative_kinematics(model, &mut data, &q, &[0.0; DOF]);
+    let mut repeated = 0;
+    for bodies in &mech.legs {
+        let foot = data.point(bodies.links[3], &mech.foot_local);
+        let mut terms = nalgebra::DMatrix::zeros(3, DOF);
+        let mut seen = [0; DOF];
+        for (c, d) in data.point_partial_velocity_terms(model, bodies.links[3], foot) {
+            let mut column = terms.column_mut(c);
+            column += d;
+            seen[c] += 1;
+        }
+        repeated += seen.iter().filter(|&&n| n > 1).count();
+        partial_velocities(model, &mut data);
+        let mut full = nalgebra::DMatrix::zeros(3, DOF);
+        for (c, d) in data.point_partial_velocities(model, bodies.links[3], &foot) {
+            full.set_column(c, &d);
+        }
+        assert_relative_eq!(terms, full, epsilon = 1e-14, max_relative = 1e-12);
+    }
+    assert!(repeated > 0, "the pantograph's columns come in several terms");
+}
+
 #[test]
 fn velocities_are_partial_velocities_times_qdot() {
     let model = tree();
