@@ -118,17 +118,9 @@ fn free_fall() {
 /// M_jk = T(e_j + e_k) − T(e_j) − T(e_k), M_jj = 2 T(e_j).
 #[test]
 fn amru5_mass_matrix_is_the_hessian_of_the_kinetic_energy() {
-    use hexadyn::description::RobotDescription;
-    use hexadyn::hexapod::{joint_index, Mechanics, MechanicsParameters, DOF};
-    let mech = Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap();
+    use hexadyn::hexapod::DOF;
+    let (mech, q) = mbs_models::amru5();
     let model = &mech.model;
-    let mut q = [0.0; DOF];
-    q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
-    for leg in 0..6 {
-        q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
-        q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
-        q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
-    }
     let (_, _, m) = energies(model, &q, &[0.0; DOF]);
     let t = |j: usize, k: usize| {
         let mut qd = [0.0; DOF];

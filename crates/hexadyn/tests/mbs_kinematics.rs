@@ -122,18 +122,10 @@ fn direct_partial_velocities_equal_numerical_derivation() {
 /// pantograph links share dependent parameters (several terms per column).
 #[test]
 fn point_partial_velocity_terms_sum_to_the_point_partial_velocity() {
-    use hexadyn::description::RobotDescription;
-    use hexadyn::hexapod::{joint_index, Mechanics, MechanicsParameters, DOF};
+    use hexadyn::hexapod::DOF;
     use hexadyn::mbs::{partial_velocities, relative_kinematics};
-    let mech = Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap();
+    let (mech, q) = mbs_models::amru5();
     let model = &mech.model;
-    let mut q = [0.0; DOF];
-    q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
-    for leg in 0..6 {
-        q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
-        q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
-        q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
-    }
     let mut data = Data::new(model);
     relative_kinematics(model, &mut data, &q, &[0.0; DOF]);
     let mut repeated = 0;

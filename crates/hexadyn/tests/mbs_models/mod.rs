@@ -1,5 +1,7 @@
 //! Multibody models shared by the integration tests.
 
+use hexadyn::description::RobotDescription;
+use hexadyn::hexapod::{joint_index, Mechanics, MechanicsParameters, DOF};
 use hexadyn::mbs::{BodySpec, Elementary, Model, ModelBuilder, Var};
 use nalgebra::{Matrix3, Vector3};
 
@@ -27,3 +29,17 @@ pub fn tree() -> Model {
     b.build()
 }
 
+/// The AMRU5's mechanics (49 bodies, the pantograph's dependent parameters shared by several
+/// links, the rotors' spins) at a generic configuration: the body tilted and off the origin,
+/// every leg's joints at other values.
+pub fn amru5() -> (Mechanics, [f64; DOF]) {
+    let mech = Mechanics::new(&MechanicsParameters::from_description(&RobotDescription::amru5())).unwrap();
+    let mut q = [0.0; DOF];
+    q[..6].copy_from_slice(&[0.1, -0.2, 0.45, 0.3, 0.05, -0.04]);
+    for leg in 0..6 {
+        q[joint_index(leg, 0)] = 0.1 * leg as f64 - 0.25;
+        q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
+        q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
+    }
+    (mech, q)
+}
