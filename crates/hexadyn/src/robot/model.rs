@@ -25,6 +25,9 @@ use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{Jacobian, Layout, Order, System};
 
+mod surrogate;
+use surrogate::Surrogate;
+
 
 /// Error scale of a bristle deflection z (Eq. 3.85) as a fraction of its steady-state value
 /// while sliding ([`LuGre::sliding_deflection`]): z carries the friction torque σ0 z, so its
@@ -313,28 +316,6 @@ pub struct Robot {
     surrogate: Option<Surrogate>,
 }
 
-/// What [`System::surrogate_residual`] expands about: an evaluation of the residual (q0, q'0,
-/// q''0, the multibody rows f0) with its foot states, contact forces and joint forces. Between
-/// two Newton iterates of a step q moves by βh² Δq'' and q' by γh Δq'' (Eq. 3.7-3.8), tiny
-/// beside the scales the kinematics change over, but the force laws are stiff and non-smooth
-/// in the same small moves (Hertz contact and its friction's linear zone, Eq. 3.72-3.73; the
-/// LuGre bristles, Eq. 3.85; the dry friction's regularisation, Eq. 6.1).
-#[derive(Clone, Debug)]
-struct Surrogate {
-    q: [f64; DOF],
-    qd: [f64; DOF],
-    qdd: [f64; DOF],
-    f: [f64; DOF],
-    /// Position, velocity and ground proximity of each foot.
-    feet: [Foot; 6],
-    /// Contact force on each foot and joint force τ_m − τ_f of each joint.
-    contact: [Vector3<f64>; 6],
-    joint: [f64; JOINTS],
-    /// The feet's J_foot (3 × 24, Eq. 3.24 for a point), taken at the first surrogate
-    /// evaluation (an evaluation whose Newton correction passes has none).
-    j_foot: Option<[nalgebra::SMatrix<f64, 3, DOF>; 6]>,
-}
-
 /// The state of a foot the contact law is evaluated at (Eq. 3.72-3.73).
 #[derive(Clone, Copy, Debug)]
 struct Foot {
@@ -538,52 +519,6 @@ impl Robot {
         self.write_state_rows(q, qd, qdd, f);
     }
 
-    /// The surrogate of the residual about `base` (see [`System::surrogate_residual`]): the force
-    /// laws exact at the feet moved by J_foot Δq and J_foot Δq' (the ground's proximity to first
-    /// order in the move, the mesh not searched again), the multibody rows
-    /// f0 + M Δq'' − Σ J_footᵀ ΔF − Δτ (Eq. 3.37 with M the kept mass matrix of the Jacobian and
-    /// the kinematics held at the base), the rows of the states exact.
-    fn write_surrogate(&mut self, base: &mut Surrogate, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
-        let j_foot = *base.j_foot.get_or_insert_with(|| {
-            self.kinematics(&base.q, &base.qd);
-            let mech = &self.model.mechanics;
-            std::array::from_fn(|leg| {
-                let mut j = nalgebra::SMatrix::<f64, 3, DOF>::zeros();
-                for (col, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
-                    let mut column = j.column_mut(col);
-                    column += d;
-                }
-                j
-            })
-        });
-        let change = |x: &[f64], x0: &[f64; DOF]| nalgebra::SVector::<f64, DOF>::from_fn(|i, _| x[i] - x0[i]);
-        let (dq, dqd, dqdd) = (change(q, &base.q), change(qd, &base.qd), change(qdd, &base.qdd));
-        let feet: [Foot; 6] = std::array::from_fn(|leg| {
-            let Foot { position, velocity, proximity: p } = base.feet[leg];
-            let dp = j_foot[leg] * dq;
-            let proximity = Proximity {
-                penetration: p.penetration + p.penetration_gradient.dot(&dp),
-                normal: p.normal + p.normal_jacobian * dp,
-                penetration_gradient: p.penetration_gradient + p.penetration_hessian * dp,
-                ..p
-            };
-            Foot { position: position + dp, velocity: velocity + j_foot[leg] * dqd, proximity }
-        });
-        self.force_laws(qd, qdd, &feet);
-        let mut rows = nalgebra::SVector::<f64, DOF>::from_column_slice(&base.f);
-        if let Some(inertial) = &self.inertial {
-            rows.gemv(1.0, &inertial.mass, &dqdd, 1.0);
-        }
-        for (leg, j) in j_foot.iter().enumerate() {
-            rows.gemv_tr(-1.0, j, &(self.outputs.contact[leg].force - base.contact[leg]), 1.0);
-        }
-        for k in 0..JOINTS {
-            rows[6 + k] -= self.outputs.motor_torque[k] - self.outputs.friction_torque[k] - base.joint[k];
-        }
-        f[..DOF].copy_from_slice(rows.as_slice());
-        self.write_state_rows(q, qd, qdd, f);
-    }
-
     /// The rows after the multibody ones: bristles (Eq. 3.85), currents (Eq. 3.91), continuous
     /// controllers (Eq. 3.96-3.97), from [`Self::outputs`]; the held body's on a stand.
     fn write_state_rows(&self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
@@ -658,21 +593,7 @@ impl System for Robot {
     /// Needs the kept mass matrix of a Jacobian (none before the first) and the evaluation at
     /// (q, q').
     fn keep_surrogate_base(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &[f64]) -> bool {
-        let evaluated = self.kinematics_at.as_ref().is_some_and(|(q0, qd0)| q0[..] == q[..DOF] && qd0[..] == qd[..DOF]);
-        let (Some(feet), Some(_), true) = (self.feet, &self.inertial, evaluated) else { return false };
-        let o = &self.outputs;
-        let array = |x: &[f64]| -> [f64; DOF] { x[..DOF].try_into().expect("DOF coordinates") };
-        self.surrogate = Some(Surrogate {
-            q: array(q),
-            qd: array(qd),
-            qdd: array(qdd),
-            f: array(f),
-            feet,
-            contact: o.contact.map(|c| c.force),
-            joint: std::array::from_fn(|k| o.motor_torque[k] - o.friction_torque[k]),
-            j_foot: None,
-        });
-        true
+        self.keep_base(q, qd, qdd, f)
     }
 
     fn surrogate_residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {

@@ -461,12 +461,7 @@ impl Newmark {
                     break;
                 }
                 let surrogate = self.options.surrogate_iterations > 0 && sys.keep_surrogate_base(self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &self.work.f);
-                let (lu, _) = self.lu.as_ref().expect("factorized");
-                let Some(newton) = lu.solve(&self.work.f) else { break };
-                // The correction of q'' with the Broyden-updated matrix (`broyden.rs`; its product
-                // form is odd in the steps, so it takes the corrections dx = −s as they are).
-                let weight = &self.work.weight_q;
-                let dx = self.broyden.step(newton, |a, b| test.dot(a, b, weight));
+                let Some(dx) = self.correction(&test) else { break };
                 self.work.qdd -= &dx;
                 let norm = test.norm(&dx, &self.work.weight_q);
                 if !norm.is_finite() {
@@ -526,6 +521,16 @@ impl Newmark {
         }
     }
 
+    /// The Newton correction of q'' for the residual in `work.f` with the kept matrix updated by
+    /// Broyden (`broyden.rs`; its product form is odd in the steps, so it takes the corrections
+    /// dx = −s as they are); `None` when the factorization cannot solve.
+    fn correction(&mut self, test: &NewtonTest) -> Option<DVector<f64>> {
+        let (lu, _) = self.lu.as_ref().expect("factorized");
+        let newton = lu.solve(&self.work.f)?;
+        let weight = &self.work.weight_q;
+        Some(self.broyden.step(newton, |a, b| test.dot(a, b, weight)))
+    }
+
     /// Newton iterations on the system's surrogate residual (`System::surrogate_residual`),
     /// about the evaluation of f just made, with the kept matrix updated by Broyden: they take
     /// q'' to the surrogate's root at the cost of its evaluations, and the next evaluation of f
@@ -540,11 +545,9 @@ impl Newmark {
             self.update_kinematics(h);
             sys.surrogate_residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
             self.stats.surrogate_evaluations += 1;
-            let (lu, _) = self.lu.as_ref().expect("factorized");
-            let Some(newton) = lu.solve(&self.work.f).filter(|x| x.iter().all(|v| v.is_finite())) else { break };
-            let weight = &self.work.weight_q;
-            let dx = self.broyden.step(newton, |a, b| test.dot(a, b, weight));
+            let Some(dx) = self.correction(test) else { break };
             let norm = test.norm(&dx, &self.work.weight_q);
+            // A non-finite surrogate gives a NaN norm, which fails the first test too.
             if !(norm <= SURROGATE_GROWTH * bound) || (iteration > 1 && norm > previous) {
                 break;
             }
