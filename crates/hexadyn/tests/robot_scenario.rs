@@ -129,17 +129,20 @@ fn errors_name_file_line_field_value_and_allowed() {
     assert!(s.contains("51") && s.contains("50"), "{s}");
 }
 
-/// `[integrator] surrogate_iterations` is opt-in: without it the robot is integrated by Newton
-/// on f alone; with it, 2 s of the validation walk take fewer residual evaluations, with the
-/// same walk to 0.1 mm (the tracking error and the distance).
+/// The robot iterates on its surrogate residual by default (`[integrator] surrogate_iterations`
+/// 8); 0 is the thesis' Newton iteration on f alone. 2 s of the validation walk: the surrogate
+/// takes fewer residual evaluations for the same walk to 0.1 mm (the tracking error and the
+/// distance).
 #[test]
-fn surrogate_iterations_are_opt_in() {
+fn surrogate_iterations_default_to_eight_and_zero_iterates_on_f_alone() {
     let run = |iterations: Option<usize>| {
         let mut overrides = vec![Override::new("scenario.duration_s", 2.0)];
         overrides.extend(iterations.map(|n| Override::new("integrator.surrogate_iterations", n as i64)));
-        run_scenario(&overridden(&overrides).unwrap(), |_| {}).unwrap().summary
+        let s = overridden(&overrides).unwrap();
+        assert_eq!(s.plant.integrator.surrogate_iterations, iterations.unwrap_or(8));
+        run_scenario(&s, |_| {}).unwrap().summary
     };
-    let (plain, surrogate) = (run(None), run(Some(8)));
+    let (plain, surrogate) = (run(Some(0)), run(None));
     assert_eq!(plain.surrogate_evaluations, 0);
     assert!(surrogate.surrogate_evaluations > 0 && surrogate.residual_evaluations < plain.residual_evaluations, "{} and {} surrogate against {} evaluations", surrogate.residual_evaluations, surrogate.surrogate_evaluations, plain.residual_evaluations);
     let (a, b) = (plain.gait.unwrap(), surrogate.gait.unwrap());
@@ -716,29 +719,48 @@ fn override_errors_name_the_override() {
 }
 
 /// One step of the validation walk (Section 6.3) with each friction model of the comparison of
-/// Section 6.4: the energy account closes within 1 % (electrical = Joule + friction + contact +
-/// Δ(T + V) + Δ stored), the summary's Eq. 6.6-6.7 quantities add up, and friction orders the
-/// specific resistance: none < dry/viscous < dry/viscous with load (Section 6.4.4), with LuGre
-/// close to dry/viscous (Section 6.4.5: "similar energy consumption").
+/// Section 6.4, integrated to convergence (tolerance 0.01, h_max 1 ms): the energy account closes
+/// within 0.1 % (electrical = Joule + friction + contact + Δ(T + V) + Δ stored; measured at most
+/// 0.014 %, without friction). At the robot's tolerance the balance error is the integration
+/// error of the step sequence, not a property of the account: without friction −0.104 J of
+/// 17.5 J with Newton on f alone, −0.210 J with the surrogate iterations, +0.212 J on f alone
+/// with h_max 1 ms (docs/performance-log.md, session 30); the walk at the robot's settings is
+/// [`walking_orders_the_friction_models`].
 #[test]
-fn walking_energy_closes_and_orders_the_friction_models() {
-    let run = |friction: &str, load: bool| {
-        let s = overridden(&[Override::new("model.friction", friction), Override::new("model.load_dependence", load), Override::new("scenario.duration_s", 12.0)]).unwrap();
-        run_scenario(&s, |_| {}).unwrap().summary
-    };
-    let xi = |s: &hexadyn::scenario::Summary| {
+fn walking_energy_account_closes_when_the_integration_converges() {
+    for (friction, load) in [("none", false), ("dry_viscous", false), ("dry_viscous", true), ("lugre", false)] {
+        let converged = [Override::new("integrator.tolerance", 0.01), Override::new("integrator.h_max_s", 1e-3)];
+        let s = validation_step(friction, load, &converged);
         let e = s.energy_electrical_j;
-        assert!(s.energy_balance_error_relative.abs() < 0.01 && s.energy_balance_error_j.abs() < 0.01 * e, "{}: imbalance {} J of {e} J", s.friction, s.energy_balance_error_j);
+        eprintln!("{friction} (load {load}): imbalance {:.3e} J of {e:.3} J", s.energy_balance_error_j);
+        assert!(s.energy_balance_error_relative.abs() < 1e-3 && s.energy_balance_error_j.abs() < 1e-3 * e, "{friction} (load {load}): imbalance {} J of {e} J", s.energy_balance_error_j);
         assert!((s.energy_electrical_by_joint_j.iter().sum::<f64>() - e).abs() < 1e-9 * e.abs());
         assert!((s.average_power_w * s.duration_s - e).abs() < 1e-9 * e.abs());
+    }
+}
+
+/// 12 s of the validation walk with `friction` and the load dependence `load`.
+fn validation_step(friction: &str, load: bool, integrator: &[Override]) -> hexadyn::scenario::Summary {
+    let mut overrides = vec![Override::new("model.friction", friction), Override::new("model.load_dependence", load), Override::new("scenario.duration_s", 12.0)];
+    overrides.extend_from_slice(integrator);
+    run_scenario(&overridden(&overrides).unwrap(), |_| {}).unwrap().summary
+}
+
+/// The same step at the robot's settings: friction orders the specific resistance (Eq. 6.6):
+/// none < dry/viscous < dry/viscous with load (Section 6.4.4), with LuGre close to dry/viscous
+/// (Section 6.4.5: "similar energy consumption"), and friction dominates the losses (Section 6.4).
+#[test]
+fn walking_orders_the_friction_models() {
+    let xi = |s: &hexadyn::scenario::Summary| {
+        let e = s.energy_electrical_j;
         assert!((s.robot_mass_kg - 34.447).abs() < 1e-9);
         let g = s.gait.as_ref().unwrap();
         assert!((g.distance_walked_m - 0.18).abs() < 0.005, "one step of 12 s at 1.5 cm/s: {}", g.distance_walked_m);
         specific_resistance(e, s.robot_mass_kg, g.distance_walked_m)
     };
-    let none = run("none", false);
-    let dry = run("dry_viscous", false);
-    let (xi_none, xi_dry, xi_load, xi_lugre) = (xi(&none), xi(&dry), xi(&run("dry_viscous", true)), xi(&run("lugre", false)));
+    let none = validation_step("none", false, &[]);
+    let dry = validation_step("dry_viscous", false, &[]);
+    let (xi_none, xi_dry, xi_load, xi_lugre) = (xi(&none), xi(&dry), xi(&validation_step("dry_viscous", true, &[])), xi(&validation_step("lugre", false, &[])));
     println!("xi: none {xi_none:.3}, dry/viscous {xi_dry:.3}, dry/viscous + load {xi_load:.3}, LuGre {xi_lugre:.3}");
     assert!(xi_none > 0.0 && xi_dry > 2.0 * xi_none, "xi without friction {xi_none}, dry/viscous {xi_dry}");
     assert!(xi_load > 1.05 * xi_dry, "the load dependence raises xi: {xi_load} vs {xi_dry}");

@@ -53,12 +53,12 @@ pub struct NewmarkOptions {
     /// only to land on requested instants or after a Newton failure.
     pub adaptive: bool,
     /// Newton iterations on the system's surrogate residual allowed after each evaluation of
-    /// the residual ([`System::surrogate_residual`]); 0 (the default): none, the thesis'
-    /// iteration on f alone. Opt-in: on the robot the iteration then seldom fails at the kinks of
-    /// the force laws, and the short steps the failures used to take there (h/4) are no longer
-    /// taken, a refinement the error estimate of Eq. 3.15 does not ask for; the energy balance
-    /// error of the walks grows about threefold at the robot's tolerance (docs/performance-log.md,
-    /// session 29).
+    /// the residual ([`System::surrogate_residual`]); 0 (the default here): none, the thesis'
+    /// iteration on f alone, the right choice for a system whose surrogate is the residual
+    /// itself. The robot's plant takes 8 (`PlantOptions::from_description`): there the
+    /// iteration seldom fails at the kinks of the force laws, so the step sequence differs from
+    /// the one on f alone within the integration error of Eq. 3.15 (docs/performance-log.md,
+    /// sessions 29-30).
     pub surrogate_iterations: usize,
 }
 
