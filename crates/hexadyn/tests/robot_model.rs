@@ -303,7 +303,8 @@ fn input_change_is_the_difference_of_two_residuals() {
 }
 
 /// At every 10 ms control instant of a second of the LuGre robot driven by jumping voltages, the
-/// reset after the jump (`Newmark::reset_accelerations_after_input_jump`) evaluates f once and
+/// reset after the jump (`Newmark::reset_accelerations_after_input_jump`) evaluates f once (with
+/// the robot's surrogate iterations: the surrogate about the last step's evaluation instead) and
 /// gives the rates of the first-order states (bristles, currents) of a Newton reset from a fresh
 /// mass matrix (a new integrator at the same (t, q, q')) within twice the Newton test of the
 /// steps (1 % of q'' plus newton_tolerance · tolerance · scale / (γ h)), and all of q'' (the
@@ -314,9 +315,16 @@ fn input_change_is_the_difference_of_two_residuals() {
 /// so that both kinds of instant occur.
 #[test]
 fn reset_after_an_input_jump_matches_the_newton_reset() {
+    let d = RobotDescription::amru5();
+    let options = PlantOptions::from_description(&d, &robot(FrictionModel::LuGre, |_| {}).model.options).integrator;
+    assert!(options.surrogate_iterations > 0);
+    reset_after_an_input_jump(NewmarkOptions { surrogate_iterations: 0, ..options.clone() });
+    reset_after_an_input_jump(options);
+}
+
+fn reset_after_an_input_jump(options: NewmarkOptions) {
     let mut r = robot(FrictionModel::LuGre, |_| {});
     let d = RobotDescription::amru5();
-    let options = PlantOptions::from_description(&d, &r.model.options).integrator;
     let q = settle(&mut r, &[0, 1, 2, 3, 4, 5]);
     let qd = vec![0.0; q.len()];
     let mut nm = Newmark::new(&mut r, 0.0, &q, &qd, options.clone()).unwrap();
@@ -327,16 +335,19 @@ fn reset_after_an_input_jump_matches_the_newton_reset() {
         options.newton_tolerance * options.tolerance * layout.scales[i] / unit
     };
     let amplitude = d.driver.supply_voltage_v;
-    let (mut evaluations, mut first_order, mut stale, mut consistent, mut others) = (0, 0.0_f64, 0.0_f64, 0, 0.0_f64);
+    let (mut evaluations, mut surrogate, mut first_order, mut stale, mut consistent, mut others) = (0, 0, 0.0_f64, 0.0_f64, 0, 0.0_f64);
     let instants = 100;
     for k in 1..=instants {
         nm.advance_to(&mut r, 0.01 * k as f64).unwrap();
         let previous = r.voltages;
         let held = nm.state().qdd.clone();
         r.voltages = std::array::from_fn(|j| amplitude * (0.7 * k as f64 + j as f64).sin());
-        let before = nm.stats().residual_evaluations;
+        let counts = |nm: &Newmark| (nm.stats().residual_evaluations, nm.stats().surrogate_evaluations);
+        let before = counts(&nm);
         nm.reset_accelerations_after_input_jump(&mut r, &previous).unwrap();
-        evaluations += nm.stats().residual_evaluations - before;
+        let after = counts(&nm);
+        evaluations += after.0 - before.0;
+        surrogate += after.1 - before.1;
         let s = nm.state();
         let newton = Newmark::new(&mut r.clone(), s.t, s.q.as_slice(), s.qd.as_slice(), options.clone()).unwrap();
         let reference = &newton.state().qdd;
@@ -351,8 +362,9 @@ fn reset_after_an_input_jump_matches_the_newton_reset() {
             others = others.max(largest);
         }
     }
-    eprintln!("reset after an input jump: {evaluations} residual evaluations over {instants} instants; first-order rates within {first_order:.2e} of twice the Newton test, all of q'' at {consistent} instants and within {others:.2e} of it at the others (q'' before the reset: {stale:.2e})");
-    assert_eq!(evaluations, instants, "one evaluation per reset");
+    eprintln!("reset after an input jump, {} surrogate iterations: {evaluations} residual and {surrogate} surrogate evaluations over {instants} instants; first-order rates within {first_order:.2e} of twice the Newton test, all of q'' at {consistent} instants and within {others:.2e} of it at the others (q'' before the reset: {stale:.2e})", options.surrogate_iterations);
+    let resets = if options.surrogate_iterations > 0 { surrogate } else { evaluations };
+    assert_eq!((resets, evaluations + surrogate), (instants, instants), "one evaluation per reset");
     assert!(stale > 100.0, "the voltage jumps move q'' by {stale} times twice the Newton test only");
     assert!(first_order <= 1.0, "first-order rates off the Newton reset by {first_order} times twice the Newton test");
     assert!(consistent >= instants / 2 && consistent < instants, "all of q'' consistent at {consistent} of {instants} instants");

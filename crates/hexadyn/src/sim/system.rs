@@ -69,7 +69,8 @@ pub trait System {
 
     /// Keeps the evaluation of [`Self::residual`] just made at (q, q', q'') with its result `f`
     /// as the base of [`Self::surrogate_residual`] and returns true; false (the default) when
-    /// the system has no surrogate.
+    /// the system has no surrogate. The base stays until the next call: evaluations of the
+    /// residual or the Jacobian in between do not change it.
     fn keep_surrogate_base(&mut self, _q: &[f64], _qd: &[f64], _qdd: &[f64], _f: &[f64]) -> bool {
         false
     }
