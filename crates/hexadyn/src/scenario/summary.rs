@@ -35,8 +35,9 @@ pub struct Summary {
     /// Evaluations of the residual f by the integrator: Newton iterations and consistent
     /// accelerations (those inside a Jacobian evaluation are not counted).
     pub residual_evaluations: u64,
-    /// Evaluations of the surrogate residual of the Newton iterations between two of f
-    /// (`System::surrogate_residual`: the force laws at the feet and joints, no kinematics).
+    /// Evaluations of the surrogate residual (`System::surrogate_residual`: the force laws at the
+    /// feet and joints, no kinematics): the Newton iterations between two of f and the resets
+    /// of q'' at the control instants.
     pub surrogate_evaluations: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,

@@ -76,9 +76,11 @@ pub trait System {
     }
 
     /// A cheaper approximation of [`Self::residual`] near the kept base, for the Newton
-    /// iterations between two evaluations of f (`Newmark`): its accuracy decides how many
+    /// iterations between two evaluations of f (`Newmark`): there its accuracy decides how many
     /// evaluations a step takes, never the accepted solution, which passes the Newton test on f
-    /// itself. The default is the residual.
+    /// itself. `Newmark::reset_accelerations_after_input_jump` also takes its correction at the
+    /// state of the step that kept the base, where it must match f within the Newton test. The
+    /// default is the residual.
     fn surrogate_residual(&mut self, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.residual(t, q, qd, qdd, f)
     }

@@ -1,7 +1,9 @@
 //! The robot's surrogate residual (`System::surrogate_residual`): the kinematics held at the last
 //! evaluation of f, the force laws (ground contact, joint friction, motors) exact at the feet
 //! moved to first order, for the Newton iterations between two evaluations of f
-//! (`Newmark::iterate_on_surrogate`, `NewmarkOptions::surrogate_iterations`: 8 on the robot by default).
+//! (`Newmark::iterate_on_surrogate`, `NewmarkOptions::surrogate_iterations`: 8 on the robot by
+//! default) and the reset of q'' after each control instant's input jump
+//! (`Newmark::reset_accelerations_after_input_jump`).
 
 use nalgebra::Vector3;
 
