@@ -39,6 +39,20 @@ impl Default for GroundContact {
     }
 }
 
+/// δ^p for δ > 0: √δ and δ √δ for the exponents 1/2 and 3/2 of Table 3.3 (p_D and the Hertz p_K,
+/// Eq. 3.74), within two units in the last place of `powf` at a tenth of its cost (a square
+/// root is one instruction; `powf` was 3 % of the 75 s walk's instructions); `powf` for any
+/// other exponent.
+fn power(delta: f64, p: f64) -> f64 {
+    if p == 1.5 {
+        delta * delta.sqrt()
+    } else if p == 0.5 {
+        delta.sqrt()
+    } else {
+        delta.powf(p)
+    }
+}
+
 /// The force of the ground on the foot and its exact Jacobians.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactForce {
@@ -111,8 +125,8 @@ impl GroundContact {
         if delta <= 0.0 {
             return out;
         }
-        let spring = self.k_gnd * delta.powf(self.p_k);
-        let damping = self.d_gnd * delta.powf(self.p_d);
+        let spring = self.k_gnd * power(delta, self.p_k);
+        let damping = self.d_gnd * power(delta, self.p_d);
         out.elastic_energy = spring * delta / (self.p_k + 1.0);
         let f_n = spring + damping * delta_rate;
         if f_n > 0.0 {
@@ -153,6 +167,21 @@ mod tests {
     use super::*;
     use crate::test_util::{assert_partial, central, noise, rng};
     use rand::Rng;
+
+    /// The square-root forms of δ^1.5 and δ^0.5 are `powf`'s within two units in the last place,
+    /// over the penetrations a foot sees (1e-9 m to 10 cm); other exponents are `powf`'s.
+    #[test]
+    fn power_is_powf_within_two_ulps() {
+        let mut r = rng(73);
+        for _ in 0..100_000 {
+            let delta = r.random_range((1e-9f64).ln()..(0.1f64).ln()).exp();
+            for p in [1.5, 0.5] {
+                let (fast, exact) = (power(delta, p), delta.powf(p));
+                assert!((fast - exact).abs() <= 2.0 * f64::EPSILON * exact, "{delta}^{p}: {fast} vs {exact}");
+            }
+            assert_eq!(power(delta, 1.3).to_bits(), delta.powf(1.3).to_bits());
+        }
+    }
 
     /// Central differences of F in p and v with steps `hp`, `hv` that cross no kink.
     fn finite_difference_check(contact: &GroundContact, terrain: &dyn Terrain, p: Vector3<f64>, v: Vector3<f64>, hp: f64, hv: f64) {

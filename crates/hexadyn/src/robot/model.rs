@@ -312,8 +312,9 @@ pub struct Robot {
     vicinity: [Vicinity; 6],
     /// The foot states of the last evaluation.
     feet: Option<[Foot; 6]>,
-    /// The base of [`System::surrogate_residual`].
-    surrogate: Option<Surrogate>,
+    /// The base of [`System::surrogate_residual`], boxed: taken out and put back at each
+    /// surrogate evaluation.
+    surrogate: Option<Box<Surrogate>>,
 }
 
 /// The state of a foot the contact law is evaluated at (Eq. 3.72-3.73).

@@ -5,11 +5,55 @@
 //! default) and the reset of q'' after each control instant's input jump
 //! (`Newmark::reset_accelerations_after_input_jump`).
 
-use nalgebra::Vector3;
+use nalgebra::{SMatrix, SVector, Vector3};
 
 use super::{Foot, Robot};
-use crate::hexapod::{DOF, JOINTS};
+use crate::hexapod::{joint_index, DOF, JOINTS};
 use crate::physics::Proximity;
+
+/// The coordinates a foot moves with: the body's six and its leg's three.
+const FOOT_COORDINATES: usize = 9;
+
+/// J_foot of one foot point (3 × 24, Eq. 3.24 for a point) on the [`FOOT_COORDINATES`] columns
+/// it can have non-zero, those of the body's six coordinates and of its leg's three joints
+/// (Eq. 3.51): the other legs' joints do not move it. The products with J_foot and J_footᵀ of a
+/// surrogate evaluation are then 3 × 9 instead of 3 × 24.
+#[derive(Clone, Copy, Debug)]
+struct FootJacobian {
+    leg: usize,
+    j: SMatrix<f64, 3, FOOT_COORDINATES>,
+}
+
+impl FootJacobian {
+    /// Column of coordinate `c` (0 to 23).
+    fn column(&self, c: usize) -> usize {
+        if c < 6 {
+            c
+        } else {
+            debug_assert!((joint_index(self.leg, 0)..joint_index(self.leg, 3)).contains(&c), "foot {} moved by coordinate {c}", self.leg);
+            6 + c - joint_index(self.leg, 0)
+        }
+    }
+
+    /// The coordinates of the columns.
+    fn coordinates(&self) -> [usize; FOOT_COORDINATES] {
+        std::array::from_fn(|k| if k < 6 { k } else { joint_index(self.leg, k - 6) })
+    }
+
+    /// J_foot Δx.
+    fn times(&self, dx: &SVector<f64, DOF>) -> Vector3<f64> {
+        let c = self.coordinates();
+        self.j * SVector::<f64, FOOT_COORDINATES>::from_fn(|k, _| dx[c[k]])
+    }
+
+    /// rows ← rows − J_footᵀ ΔF.
+    fn subtract_transpose_times(&self, force: &Vector3<f64>, rows: &mut SVector<f64, DOF>) {
+        let product = self.j.tr_mul(force);
+        for (k, c) in self.coordinates().into_iter().enumerate() {
+            rows[c] -= product[k];
+        }
+    }
+}
 
 /// What [`crate::sim::System::surrogate_residual`] expands about: an evaluation of the residual (q0, q'0,
 /// q''0, the multibody rows f0) with its foot states, contact forces and joint forces. Between
@@ -28,9 +72,9 @@ pub(super) struct Surrogate {
     /// Contact force on each foot and joint force τ_m − τ_f of each joint.
     contact: [Vector3<f64>; 6],
     joint: [f64; JOINTS],
-    /// The feet's J_foot (3 × 24, Eq. 3.24 for a point), taken at the first surrogate
-    /// evaluation (an evaluation whose Newton correction passes has none).
-    j_foot: Option<[nalgebra::SMatrix<f64, 3, DOF>; 6]>,
+    /// The feet's J_foot, taken at the first surrogate evaluation (an evaluation whose Newton
+    /// correction passes has none).
+    j_foot: Option<[FootJacobian; 6]>,
 }
 
 impl Robot {
@@ -41,7 +85,7 @@ impl Robot {
         let (Some(feet), Some(_), true) = (self.feet, &self.inertial, evaluated) else { return false };
         let o = &self.outputs;
         let array = |x: &[f64]| -> [f64; DOF] { x[..DOF].try_into().expect("DOF coordinates") };
-        self.surrogate = Some(Surrogate {
+        self.surrogate = Some(Box::new(Surrogate {
             q: array(q),
             qd: array(qd),
             qdd: array(qdd),
@@ -50,7 +94,7 @@ impl Robot {
             contact: o.contact.map(|c| c.force),
             joint: std::array::from_fn(|k| o.motor_torque[k] - o.friction_torque[k]),
             j_foot: None,
-        });
+        }));
         true
     }
 
@@ -60,38 +104,39 @@ impl Robot {
     /// f0 + M Δq'' − Σ J_footᵀ ΔF − Δτ (Eq. 3.37 with M the kept mass matrix of the Jacobian and
     /// the kinematics held at the base), the rows of the states exact.
     pub(super) fn write_surrogate(&mut self, base: &mut Surrogate, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
-        let j_foot = *base.j_foot.get_or_insert_with(|| {
+        if base.j_foot.is_none() {
             self.kinematics(&base.q, &base.qd);
             let mech = &self.model.mechanics;
-            std::array::from_fn(|leg| {
-                let mut j = nalgebra::SMatrix::<f64, 3, DOF>::zeros();
-                for (col, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
-                    let mut column = j.column_mut(col);
+            base.j_foot = Some(std::array::from_fn(|leg| {
+                let mut foot = FootJacobian { leg, j: SMatrix::zeros() };
+                for (c, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
+                    let mut column = foot.j.column_mut(foot.column(c));
                     column += d;
                 }
-                j
-            })
-        });
-        let change = |x: &[f64], x0: &[f64; DOF]| nalgebra::SVector::<f64, DOF>::from_fn(|i, _| x[i] - x0[i]);
+                foot
+            }));
+        }
+        let j_foot = base.j_foot.as_ref().expect("taken above");
+        let change = |x: &[f64], x0: &[f64; DOF]| SVector::<f64, DOF>::from_fn(|i, _| x[i] - x0[i]);
         let (dq, dqd, dqdd) = (change(q, &base.q), change(qd, &base.qd), change(qdd, &base.qdd));
         let feet: [Foot; 6] = std::array::from_fn(|leg| {
             let Foot { position, velocity, proximity: p } = base.feet[leg];
-            let dp = j_foot[leg] * dq;
+            let dp = j_foot[leg].times(&dq);
             let proximity = Proximity {
                 penetration: p.penetration + p.penetration_gradient.dot(&dp),
                 normal: p.normal + p.normal_jacobian * dp,
                 penetration_gradient: p.penetration_gradient + p.penetration_hessian * dp,
                 ..p
             };
-            Foot { position: position + dp, velocity: velocity + j_foot[leg] * dqd, proximity }
+            Foot { position: position + dp, velocity: velocity + j_foot[leg].times(&dqd), proximity }
         });
         self.force_laws(qd, qdd, &feet);
-        let mut rows = nalgebra::SVector::<f64, DOF>::from_column_slice(&base.f);
+        let mut rows = SVector::<f64, DOF>::from_column_slice(&base.f);
         if let Some(inertial) = &self.inertial {
             rows.gemv(1.0, &inertial.mass, &dqdd, 1.0);
         }
         for (leg, j) in j_foot.iter().enumerate() {
-            rows.gemv_tr(-1.0, j, &(self.outputs.contact[leg].force - base.contact[leg]), 1.0);
+            j.subtract_transpose_times(&(self.outputs.contact[leg].force - base.contact[leg]), &mut rows);
         }
         for k in 0..JOINTS {
             rows[6 + k] -= self.outputs.motor_torque[k] - self.outputs.friction_torque[k] - base.joint[k];
