@@ -75,7 +75,9 @@ impl DependentFunction for PantographGeometry {
     }
 
     /// [`PantographGeometry::dependent_parameters`] differentiated by hand through k = |AD|:
-    /// p1 = acos(u1(k²)), p0 = acos(u0(k)) − asin(q_v / k).
+    /// p1 = acos(u1(k²)), p0 = acos(u0(k)) − asin(q_v / k); their sines and cosines from the
+    /// same arguments, (sin p1, cos p1) = (√(1 − u1²), u1) and, with a = acos(u0), b = asin(w),
+    /// sin p0 = sin a cos b − cos a sin b, cos p0 = cos a cos b + sin a sin b.
     fn eval_closed_form(&self, x: &[f64], xd: &[f64], out: &mut [DependentValue]) -> bool {
         let (c, l) = (self.c, self.l1);
         let (v, h, vd, hd) = (x[0], x[1], xd[0], xd[1]);
@@ -96,11 +98,16 @@ impl DependentFunction for PantographGeometry {
         };
         let p0 = u0.acos().minus(&w.asin());
         let p1 = u1.acos();
-        for (o, p) in out.iter_mut().zip([p0, p1]) {
+        let root = |u: f64| (1.0 - u * u).sqrt();
+        let (sin_a, cos_b) = (root(u0.value), root(w.value));
+        let sin_cos_p0 = (sin_a * cos_b - u0.value * w.value, u0.value * cos_b + sin_a * w.value);
+        let sin_cos_p1 = (root(u1.value), u1.value);
+        for (o, (p, sin_cos)) in out.iter_mut().zip([(p0, sin_cos_p0), (p1, sin_cos_p1)]) {
             o.value = p.value;
             o.rate = p.rate;
             o.bias = p.bias;
             o.gradient.copy_from_slice(&p.gradient);
+            o.sin_cos = Some(sin_cos);
         }
         true
     }
@@ -157,7 +164,7 @@ mod tests {
     }
 
     /// The closed-form derivatives are those of the jets of `eval` (the definition), over the
-    /// joint ranges and at any rates.
+    /// joint ranges and at any rates, and its sines and cosines those of the values.
     #[test]
     fn closed_form_derivatives_match_the_jets() {
         let fresh = || vec![DependentValue { gradient: vec![0.0; 2], ..Default::default() }; 2];
@@ -172,6 +179,10 @@ mod tests {
                 for (cg, jg) in c.gradient.iter().zip(&j.gradient) {
                     assert_relative_eq!(*cg, *jg, max_relative = 1e-12);
                 }
+                let (sin, cos) = c.sin_cos.expect("the closed form gives them");
+                assert_relative_eq!(sin, c.value.sin(), epsilon = 1e-15);
+                assert_relative_eq!(cos, c.value.cos(), epsilon = 1e-15);
+                assert_eq!(j.sin_cos, None);
             }
         }
     }

@@ -26,7 +26,8 @@ pub trait DependentFunction: Send + Sync + std::fmt::Debug {
     fn eval(&self, x: &[Jet], p: &mut [Jet]);
 
     /// The same derivatives in closed form, for functions that have it cheaper than the jets:
-    /// fills `out` (value, rate, bias, gradient of each output) at (x, ẋ) and returns true.
+    /// fills `out` (value, rate, bias, gradient of each output, and its sine and cosine when it
+    /// is an angle that has them cheaper than `sin_cos`) at (x, ẋ) and returns true.
     /// [`Self::eval`] stays the definition, and tests hold the two together
     /// ([`evaluate_jets`]). The default has no closed form.
     fn eval_closed_form(&self, _x: &[f64], _xd: &[f64], _out: &mut [DependentValue]) -> bool {
@@ -44,6 +45,10 @@ pub struct DependentValue {
     pub bias: f64,
     /// ∂p/∂x for each input of the group.
     pub gradient: Vec<f64>,
+    /// (sin p, cos p) when the closed form gives them (an angle it has as an arc cosine, whose
+    /// sine and cosine are algebraic in its argument); the kinematics takes those of the joint
+    /// angles from here instead of evaluating them ([`DependentFunction::eval_closed_form`]).
+    pub sin_cos: Option<(f64, f64)>,
 }
 
 /// Evaluates a group at (x, ẋ): in closed form when the function has it, else on jets.
@@ -72,5 +77,6 @@ pub fn evaluate_jets(function: &dyn DependentFunction, x: &[f64], xd: &[f64], ou
         o.rate = p.eps2.unwrap_generic(U1, U1)[0];
         o.bias = (0..ni).map(|j| hessian_xd[j] * xd[j]).sum();
         o.gradient.copy_from_slice(&gradient.as_slice()[..ni]);
+        o.sin_cos = None;
     }
 }

@@ -216,8 +216,10 @@ pub struct Model {
     pub(crate) dependent_count: usize,
     pub(crate) column_total: usize,
     pub(crate) own_total: usize,
-    /// The distinct variables of the rotations (see [`CompiledElementary::Rotation`]).
+    /// The distinct variables of the rotations (see [`CompiledElementary::Rotation`]), with the
+    /// sine and cosine of their offsets.
     pub(crate) angles: Vec<Var>,
+    pub(crate) angle_offsets: Vec<(f64, f64)>,
     /// Gravity acceleration in the global frame (m/s²).
     pub gravity: Vector3<f64>,
 }
@@ -418,6 +420,7 @@ impl ModelBuilder {
             dependent_count: self.dependent_count,
             column_total: offset,
             own_total: own_offset,
+            angle_offsets: angles.iter().map(|a| a.offset.sin_cos()).collect(),
             angles,
             gravity: self.gravity,
         }

@@ -38,8 +38,16 @@ impl Jacobian {
 
 /// Column-by-column central finite-difference estimate of M, CT and KT (the EasyDyn method of
 /// Section 3.3.2). It is the fallback for systems without analytic blocks and the oracle the
-/// analytic blocks are tested against.
+/// analytic blocks are tested against. The steps are 1e-6 times the coordinate or its scale
+/// ([`finite_difference_jacobian_with_steps`]).
 pub fn finite_difference_jacobian<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Jacobian {
+    finite_difference_jacobian_with_steps(sys, t, q, qd, qdd, 1e-6)
+}
+
+/// [`finite_difference_jacobian`] with the steps `relative` times the coordinate or its scale:
+/// a test compares two step sizes to see the estimate's own error (rounding grows as the step
+/// shrinks, truncation as it grows).
+pub fn finite_difference_jacobian_with_steps<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64], relative: f64) -> Jacobian {
     let n = q.len();
     let scales = sys.layout().scales.clone();
     let mut jac = Jacobian::zeros(n);
@@ -51,7 +59,7 @@ pub fn finite_difference_jacobian<S: System + ?Sized>(sys: &mut S, t: f64, q: &[
             // Residuals are usually linear in q'' (rounding is the only error there: take a
             // unit floor); q and q' steps follow the coordinate's scale.
             let floor = if block == 2 { 1.0 } else { scales.get(j).copied().unwrap_or(1.0) };
-            let step = 1e-6 * x0.abs().max(floor).max(1e-12);
+            let step = relative * x0.abs().max(floor).max(1e-12);
             x[block][j] = x0 + step;
             sys.residual(t, &x[0], &x[1], &x[2], &mut fp);
             x[block][j] = x0 - step;

@@ -12,7 +12,7 @@ mod statics;
 mod system;
 
 pub use error::{ResidualRow, SimError};
-pub use jacobian::{finite_difference_jacobian, Jacobian};
+pub use jacobian::{finite_difference_jacobian, finite_difference_jacobian_with_steps, Jacobian};
 pub use linearize::{linearize, Linearization, Pole};
 pub use newmark::{Newmark, NewmarkOptions, NewmarkStats, State};
 pub use statics::{static_equilibrium, StaticOptions};
