@@ -478,8 +478,7 @@ impl Newmark {
                 if self.work.f.iter().any(|x| !x.is_finite()) {
                     break;
                 }
-                let surrogate = self.options.surrogate_iterations > 0 && sys.keep_surrogate_base(self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &self.work.f);
-                self.surrogate_base = surrogate;
+                self.surrogate_base = self.options.surrogate_iterations > 0 && sys.keep_surrogate_base(self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &self.work.f);
                 let Some(dx) = self.correction(&test) else { break };
                 self.work.qdd -= &dx;
                 let norm = test.norm(&dx, &self.work.weight_q);
@@ -513,7 +512,7 @@ impl Newmark {
                     break;
                 }
                 previous = norm;
-                if surrogate {
+                if self.surrogate_base {
                     self.iterate_on_surrogate(sys, h, t_new, &test, norm);
                 }
             }
