@@ -121,13 +121,6 @@ impl Data {
     pub fn point_velocity(&self, b: BodyId, p: &Vector3<f64>) -> Vector3<f64> {
         self.velocity[b.0] + self.omega[b.0].cross(&(p - self.pose[b.0].translation))
     }
-    /// Convective acceleration J̇ q̇ of a material point of body b at global position `p`: its
-    /// acceleration at q̈ = 0 (Eq. 3.27 for a point, a_G + α × r + ω × (ω × r) with the bias
-    /// terms of G_b), the derivative of its velocity along q̇ at fixed q̇.
-    pub fn point_acceleration_bias(&self, b: BodyId, p: &Vector3<f64>) -> Vector3<f64> {
-        let (r, omega) = (p - self.pose[b.0].translation, self.omega[b.0]);
-        self.accel_bias[b.0] + self.alpha_bias[b.0].cross(&r) + omega.cross(&omega.cross(&r))
-    }
     /// Linear acceleration of G_b for the accelerations q̈ (Eq. 3.27).
     pub fn acceleration(&self, model: &Model, b: BodyId, qdd: &[f64]) -> Vector3<f64> {
         self.assert_complete();

@@ -14,7 +14,7 @@
 use std::ops::RangeInclusive;
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, SMatrix, Vector3};
+use nalgebra::{DMatrix, Vector3};
 
 use crate::description::{JointFrictionParameters, RobotDescription};
 use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
@@ -331,14 +331,14 @@ struct Foot {
 #[derive(Clone, Debug)]
 struct InertialJacobian {
     q: Vec<f64>,
-    kt: SMatrix<f64, DOF, DOF>,
-    ct: SMatrix<f64, DOF, DOF>,
+    kt: DMatrix<f64>,
+    ct: DMatrix<f64>,
     /// ∂v_foot/∂q per foot (3 × 24).
     dv_dq: Vec<nalgebra::Matrix3xX<f64>>,
     /// The mass matrix of the multibody rows (Eq. 3.39): it changes with the configuration as
     /// slowly as the terms above (2 % fewer instructions on the 75 s LuGre walk than taking it
     /// at every Jacobian, the Newton iterations the same to 0.1 %).
-    mass: SMatrix<f64, DOF, DOF>,
+    mass: DMatrix<f64>,
 }
 
 impl InertialJacobian {
@@ -410,7 +410,7 @@ impl Robot {
         let scales = self.model.layout.scales.clone();
         let mut mass = DMatrix::zeros(DOF, DOF);
         mbs::mass_matrix(&self.model.mechanics.model, &self.data, &mut mass);
-        let mut jac = InertialJacobian { q: q.to_vec(), kt: SMatrix::zeros(), ct: SMatrix::zeros(), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6], mass: SMatrix::from_column_slice(mass.as_slice()) };
+        let mut jac = InertialJacobian { q: q.to_vec(), kt: DMatrix::zeros(DOF, DOF), ct: DMatrix::zeros(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6], mass };
         let (mut f0, mut fp) = (vec![0.0; DOF], vec![0.0; DOF]);
         let (mut v0, mut vp) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
         self.frozen_residual(q, qd, qdd, &contact, &joint, &mut f0, &mut v0);

@@ -52,9 +52,8 @@ pub struct NewmarkOptions {
     /// Adapt h from the error estimate (Eq. 3.15); with `false` the step is h_max, shortened
     /// only to land on requested instants or after a Newton failure.
     pub adaptive: bool,
-    /// Newton iterations on the system's surrogate residual ([`System::surrogate_residual`])
-    /// allowed after each evaluation of the residual, and before the first evaluation of a step
-    /// about the last evaluation of the step before; 0 (the default here): none, the thesis'
+    /// Newton iterations on the system's surrogate residual allowed after each evaluation of
+    /// the residual ([`System::surrogate_residual`]); 0 (the default here): none, the thesis'
     /// iteration on f alone, the right choice for a system whose surrogate is the residual
     /// itself. The robot's plant takes 8 (`PlantOptions::from_description`): there the
     /// iteration seldom fails at the kinks of the force laws, so the step sequence differs from
@@ -470,12 +469,6 @@ impl Newmark {
             }
             let mut previous = f64::INFINITY;
             self.broyden.clear();
-            if self.surrogate_base && !self.jacobian_fresh {
-                // The predictor taken first to the root of the surrogate about the last
-                // evaluation of f (the last step's, or this step's failed attempt's): the first
-                // evaluation of f then often finds a correction that passes.
-                self.iterate_on_surrogate(sys, h, t_new, &test, f64::INFINITY);
-            }
             for iteration in 0..self.options.max_iterations {
                 self.update_kinematics(h);
                 sys.residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
@@ -557,11 +550,11 @@ impl Newmark {
     }
 
     /// Newton iterations on the system's surrogate residual (`System::surrogate_residual`),
-    /// about the last evaluation of f, with the kept matrix updated by Broyden: they take q'' to
-    /// the surrogate's root at the cost of its evaluations, and the next evaluation of f judges
-    /// the iterate by the Newton test as any other. A correction more than [`SURROGATE_GROWTH`]
-    /// times `bound` (the last correction from f; infinite before the step's first evaluation),
-    /// or growing after the second, is not taken. INTERPRETATION: the thesis iterates on f alone (Section 3.3.2);
+    /// about the evaluation of f just made, with the kept matrix updated by Broyden: they take
+    /// q'' to the surrogate's root at the cost of its evaluations, and the next evaluation of f
+    /// judges the iterate by the Newton test as any other. A correction more than
+    /// [`SURROGATE_GROWTH`] times `bound` (the last correction from f), or growing after the
+    /// second, is not taken. INTERPRETATION: the thesis iterates on f alone (Section 3.3.2);
     /// the surrogate changes the path of the iteration, not what it accepts.
     fn iterate_on_surrogate<S: System + ?Sized>(&mut self, sys: &mut S, h: f64, t_new: f64, test: &NewtonTest, bound: f64) {
         self.broyden.clear();

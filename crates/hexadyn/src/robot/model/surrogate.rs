@@ -1,9 +1,9 @@
-//! The robot's surrogate residual (`System::surrogate_residual`): the multibody rows to first
-//! order about the last evaluation of f, the force laws (ground contact, joint friction, motors)
-//! exact at the feet moved to first order, for the Newton iterations of a step before its first
-//! evaluation of f and between two of them (`Newmark::iterate_on_surrogate`,
-//! `NewmarkOptions::surrogate_iterations`: 8 on the robot by default) and the reset of q'' after
-//! each control instant's input jump (`Newmark::reset_accelerations_after_input_jump`).
+//! The robot's surrogate residual (`System::surrogate_residual`): the kinematics held at the last
+//! evaluation of f, the force laws (ground contact, joint friction, motors) exact at the feet
+//! moved to first order, for the Newton iterations between two evaluations of f
+//! (`Newmark::iterate_on_surrogate`, `NewmarkOptions::surrogate_iterations`: 8 on the robot by
+//! default) and the reset of q'' after each control instant's input jump
+//! (`Newmark::reset_accelerations_after_input_jump`).
 
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -14,15 +14,14 @@ use crate::physics::Proximity;
 /// The coordinates a foot moves with: the body's six and its leg's three.
 const FOOT_COORDINATES: usize = 9;
 
-/// J_foot of one foot point (3 × 24, Eq. 3.24 for a point) and ∂v_foot/∂q on the
-/// [`FOOT_COORDINATES`] columns they can have non-zero, those of the body's six coordinates and
-/// of its leg's three joints (Eq. 3.51): the other legs' joints do not move the foot. The
-/// products of a surrogate evaluation are then 3 × 9 instead of 3 × 24.
+/// J_foot of one foot point (3 × 24, Eq. 3.24 for a point) on the [`FOOT_COORDINATES`] columns
+/// it can have non-zero, those of the body's six coordinates and of its leg's three joints
+/// (Eq. 3.51): the other legs' joints do not move it. The products with J_foot and J_footᵀ of a
+/// surrogate evaluation are then 3 × 9 instead of 3 × 24.
 #[derive(Clone, Copy, Debug)]
 struct FootJacobian {
     leg: usize,
     j: SMatrix<f64, 3, FOOT_COORDINATES>,
-    dv_dq: SMatrix<f64, 3, FOOT_COORDINATES>,
 }
 
 impl FootJacobian {
@@ -41,10 +40,10 @@ impl FootJacobian {
         std::array::from_fn(|k| if k < 6 { k } else { joint_index(self.leg, k - 6) })
     }
 
-    /// The entries of Δx on the columns.
-    fn gather(&self, dx: &SVector<f64, DOF>) -> SVector<f64, FOOT_COORDINATES> {
+    /// J_foot Δx.
+    fn times(&self, dx: &SVector<f64, DOF>) -> Vector3<f64> {
         let c = self.coordinates();
-        SVector::from_fn(|k, _| dx[c[k]])
+        self.j * SVector::<f64, FOOT_COORDINATES>::from_fn(|k, _| dx[c[k]])
     }
 
     /// rows ← rows − J_footᵀ ΔF.
@@ -56,27 +55,12 @@ impl FootJacobian {
     }
 }
 
-/// rows ← rows + A x for a derivative A of the multibody rows (M, KT_i or CT_i of Eq. 3.12, 3.39)
-/// by its non-zero blocks: no body of a leg moves with another leg's joints (Eq. 3.51), so a
-/// leg's rows depend on the body's coordinates and on its own leg's alone and only the body's
-/// six rows are full (306 of the 576 products).
-fn add_leg_structured_product(a: &SMatrix<f64, DOF, DOF>, x: &SVector<f64, DOF>, rows: &mut SVector<f64, DOF>) {
-    rows.fixed_rows_mut::<6>(0).gemv(1.0, &a.fixed_rows::<6>(0), x, 1.0);
-    for leg in 0..6 {
-        let r = joint_index(leg, 0);
-        let mut out = rows.fixed_rows_mut::<3>(r);
-        out.gemv(1.0, &a.fixed_view::<3, 6>(r, 0), &x.fixed_rows::<6>(0), 1.0);
-        out.gemv(1.0, &a.fixed_view::<3, 3>(r, r), &x.fixed_rows::<3>(r), 1.0);
-    }
-}
-
 /// What [`crate::sim::System::surrogate_residual`] expands about: an evaluation of the residual (q0, q'0,
 /// q''0, the multibody rows f0) with its foot states, contact forces and joint forces. Between
-/// two Newton iterates of a step q moves by βh² Δq'' and q' by γh Δq'' (Eq. 3.7-3.8), and from
-/// the last evaluation of one step to the first iterate of the next by about h q' and h q'':
-/// small beside the scales the kinematics change over, but the force laws are stiff and
-/// non-smooth in the same small moves (Hertz contact and its friction's linear zone,
-/// Eq. 3.72-3.73; the LuGre bristles, Eq. 3.85; the dry friction's regularisation, Eq. 6.1).
+/// two Newton iterates of a step q moves by βh² Δq'' and q' by γh Δq'' (Eq. 3.7-3.8), tiny
+/// beside the scales the kinematics change over, but the force laws are stiff and non-smooth
+/// in the same small moves (Hertz contact and its friction's linear zone, Eq. 3.72-3.73; the
+/// LuGre bristles, Eq. 3.85; the dry friction's regularisation, Eq. 6.1).
 #[derive(Clone, Debug)]
 pub(super) struct Surrogate {
     q: [f64; DOF],
@@ -88,8 +72,8 @@ pub(super) struct Surrogate {
     /// Contact force on each foot and joint force τ_m − τ_f of each joint.
     contact: [Vector3<f64>; 6],
     joint: [f64; JOINTS],
-    /// The feet's J_foot and ∂v_foot/∂q, taken at the first surrogate evaluation (an evaluation
-    /// whose Newton correction passes has none).
+    /// The feet's J_foot, taken at the first surrogate evaluation (an evaluation whose Newton
+    /// correction passes has none).
     j_foot: Option<[FootJacobian; 6]>,
 }
 
@@ -115,43 +99,19 @@ impl Robot {
     }
 
     /// The surrogate of the residual about `base` (see [`crate::sim::System::surrogate_residual`]): the force
-    /// laws exact at the feet moved by J_foot Δq and with velocities changed by
-    /// J_foot Δq' + ∂v_foot/∂q Δq (the ground's proximity to first order in the move, the mesh
-    /// not searched again), the multibody rows
-    /// f0 + M Δq'' + KT_i Δq + CT_i Δq' − Σ J_footᵀ ΔF − Δτ (Eq. 3.37 to first order, with M, KT_i
-    /// and CT_i the inertial part of the kept Jacobian, Eq. 3.12: inertia, gravity and the
-    /// geometry of the points the forces act at, the forces held), the rows of the states exact.
-    /// Over a step (Δq ≈ h q') a stance foot's velocity changes by ∂v_foot/∂q Δq as much as the
-    /// linear zone of its friction (Eq. 3.73) spans; without these terms the surrogate missed
-    /// some 27 N on a nut row of the 75 s LuGre walk over each step (the rotation q_r of a
-    /// stance leg; docs/performance-log.md, session 32).
+    /// laws exact at the feet moved by J_foot Δq and J_foot Δq' (the ground's proximity to first
+    /// order in the move, the mesh not searched again), the multibody rows
+    /// f0 + M Δq'' − Σ J_footᵀ ΔF − Δτ (Eq. 3.37 with M the kept mass matrix of the Jacobian and
+    /// the kinematics held at the base), the rows of the states exact.
     pub(super) fn write_surrogate(&mut self, base: &mut Surrogate, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         if base.j_foot.is_none() {
             self.kinematics(&base.q, &base.qd);
             let mech = &self.model.mechanics;
-            let inertial = self.inertial.as_ref().expect("a base is kept with the inertial Jacobian");
-            let scales = &self.model.layout.scales;
             base.j_foot = Some(std::array::from_fn(|leg| {
-                let mut foot = FootJacobian { leg, j: SMatrix::zeros(), dv_dq: SMatrix::zeros() };
+                let mut foot = FootJacobian { leg, j: SMatrix::zeros() };
                 for (c, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
                     let mut column = foot.j.column_mut(foot.column(c));
                     column += d;
-                }
-                for (k, c) in foot.coordinates().into_iter().enumerate() {
-                    foot.dv_dq.set_column(k, &inertial.dv_dq[leg].column(c));
-                }
-                // ∂v_foot/∂q = (∂J_foot/∂q) q' is the Jacobian's, taken at another q' (it is kept
-                // while q moves little). Along q'0 it is known exactly at the base: the foot
-                // point's convective acceleration J̇_foot q'0 (Eq. 3.27 at q'' = 0). The kept
-                // matrix is corrected by the rank-one update that makes it exact along q'0 and
-                // leaves it unchanged across (Broyden's, in the metric of the coordinates'
-                // scales): over a step q moves by about h q'0.
-                let rate = foot.gather(&SVector::from_column_slice(&base.qd));
-                let w2_rate = SVector::<f64, FOOT_COORDINATES>::from_iterator(foot.coordinates().into_iter().zip(rate.iter()).map(|(c, r)| r / (scales[c] * scales[c])));
-                let norm = rate.dot(&w2_rate);
-                if norm > 0.0 {
-                    let miss = self.data.point_acceleration_bias(mech.legs[leg].links[3], &base.feet[leg].position) - foot.dv_dq * rate;
-                    foot.dv_dq += miss * (w2_rate / norm).transpose();
                 }
                 foot
             }));
@@ -161,23 +121,19 @@ impl Robot {
         let (dq, dqd, dqdd) = (change(q, &base.q), change(qd, &base.qd), change(qdd, &base.qdd));
         let feet: [Foot; 6] = std::array::from_fn(|leg| {
             let Foot { position, velocity, proximity: p } = base.feet[leg];
-            let foot = &j_foot[leg];
-            let dq_foot = foot.gather(&dq);
-            let dp = foot.j * dq_foot;
+            let dp = j_foot[leg].times(&dq);
             let proximity = Proximity {
                 penetration: p.penetration + p.penetration_gradient.dot(&dp),
                 normal: p.normal + p.normal_jacobian * dp,
                 penetration_gradient: p.penetration_gradient + p.penetration_hessian * dp,
                 ..p
             };
-            Foot { position: position + dp, velocity: velocity + foot.j * foot.gather(&dqd) + foot.dv_dq * dq_foot, proximity }
+            Foot { position: position + dp, velocity: velocity + j_foot[leg].times(&dqd), proximity }
         });
         self.force_laws(qd, qdd, &feet);
         let mut rows = SVector::<f64, DOF>::from_column_slice(&base.f);
         if let Some(inertial) = &self.inertial {
-            add_leg_structured_product(&inertial.mass, &dqdd, &mut rows);
-            add_leg_structured_product(&inertial.kt, &dq, &mut rows);
-            add_leg_structured_product(&inertial.ct, &dqd, &mut rows);
+            rows.gemv(1.0, &inertial.mass, &dqdd, 1.0);
         }
         for (leg, j) in j_foot.iter().enumerate() {
             j.subtract_transpose_times(&(self.outputs.contact[leg].force - base.contact[leg]), &mut rows);
