@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, Vector3};
 
 use super::data::Data;
 use super::dependent;
-use super::model::{CompiledElementary, CompiledVar, Model, Source, Var};
+use super::model::{Angle, CompiledElementary, CompiledVar, Model, Source, Var};
 use crate::spatial::Htm;
 
 /// Value, rate, convective second derivative and gradient (per compiled column) of a variable.
@@ -32,15 +32,16 @@ fn var_state(v: &Var, q: &[f64], qd: &[f64], dependents: &[super::DependentValue
     }
 }
 
-/// (sin, cos) of the joint angle `var` = scale p + offset: from (sin p, cos p) when the dependent
-/// parameter p has them and scale = ±1, sin(±p + o) = ±sin p cos o + cos p sin o and
-/// cos(±p + o) = cos p cos o ∓ sin p sin o with `offset` = (sin o, cos o); otherwise `sin_cos`
-/// of the angle (the pantograph's angles come from their arc cosines: 12 of the 21 angles of the
+/// (sin, cos) of the joint angle scale p + o: from (sin p, cos p) when the dependent parameter p
+/// has them and scale = ±1, sin(±p + o) = ±sin p cos o + cos p sin o and
+/// cos(±p + o) = cos p cos o ∓ sin p sin o with (sin o, cos o) kept in the [`Angle`]; otherwise
+/// `sin_cos` of the angle (the pantograph's angles come from their arc cosines: 12 of the 21 angles of the
 /// hexapod, 12 of the 21 evaluations of `sin_cos` per kinematics, each about 200 instructions).
-fn angle_sin_cos(var: &Var, offset: (f64, f64), q: &[f64], qd: &[f64], dependents: &[super::DependentValue]) -> (f64, f64) {
+fn angle_sin_cos(angle: &Angle, q: &[f64], qd: &[f64], dependents: &[super::DependentValue]) -> (f64, f64) {
+    let var = &angle.var;
     if let (Source::Dependent(k), true) = (var.source, var.scale.abs() == 1.0) {
         if let Some((s, c)) = dependents[k].sin_cos {
-            let ((so, co), s) = (offset, var.scale * s);
+            let ((so, co), s) = (angle.offset_sin_cos, var.scale * s);
             return (s * co + c * so, c * co - s * so);
         }
     }
@@ -98,8 +99,8 @@ pub fn relative_kinematics(model: &Model, data: &mut Data, q: &[f64], qd: &[f64]
     data.complete = false;
     // Sine and cosine of each distinct joint angle, once (links moving in parallel, e.g. the
     // pantograph's, turn by the same dependent parameter).
-    for ((sc, var), &offset) in data.angles.iter_mut().zip(&model.angles).zip(&model.angle_offsets) {
-        *sc = angle_sin_cos(var, offset, q, qd, &data.dependents);
+    for (sc, angle) in data.angles.iter_mut().zip(&model.angles) {
+        *sc = angle_sin_cos(angle, q, qd, &data.dependents);
     }
     // The relative partial velocities are accumulated below: zeroed once for all bodies (one
     // fill rather than a small one per body).

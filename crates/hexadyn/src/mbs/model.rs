@@ -206,6 +206,14 @@ impl Body {
     }
 }
 
+/// A distinct variable of the rotations, with the sine and cosine of its offset (the kinematics
+/// turns those of a dependent parameter into the angle's, `kinematics::angle_sin_cos`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Angle {
+    pub(crate) var: Var,
+    pub(crate) offset_sin_cos: (f64, f64),
+}
+
 /// Immutable multibody description (Model/Data split). Cheap to clone: dependent functions
 /// are shared.
 #[derive(Clone, Debug)]
@@ -216,10 +224,8 @@ pub struct Model {
     pub(crate) dependent_count: usize,
     pub(crate) column_total: usize,
     pub(crate) own_total: usize,
-    /// The distinct variables of the rotations (see [`CompiledElementary::Rotation`]), with the
-    /// sine and cosine of their offsets.
-    pub(crate) angles: Vec<Var>,
-    pub(crate) angle_offsets: Vec<(f64, f64)>,
+    /// The distinct variables of the rotations (see [`CompiledElementary::Rotation`]).
+    pub(crate) angles: Vec<Angle>,
     /// Gravity acceleration in the global frame (m/s²).
     pub gravity: Vector3<f64>,
 }
@@ -420,8 +426,7 @@ impl ModelBuilder {
             dependent_count: self.dependent_count,
             column_total: offset,
             own_total: own_offset,
-            angle_offsets: angles.iter().map(|a| a.offset.sin_cos()).collect(),
-            angles,
+            angles: angles.into_iter().map(|var| Angle { var, offset_sin_cos: var.offset.sin_cos() }).collect(),
             gravity: self.gravity,
         }
     }
