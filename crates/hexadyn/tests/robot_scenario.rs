@@ -127,6 +127,34 @@ fn errors_name_file_line_field_value_and_allowed() {
 
     let s = field_error(&with("stand_six_legs", "[model]", "[integrator]\nsurrogate_iterations = 51\n[model]"), "integrator.surrogate_iterations");
     assert!(s.contains("51") && s.contains("50"), "{s}");
+
+    let s = field_error(&with("stand_six_legs", "[model]", "[integrator]\nunverified_steps = 1001\n[model]"), "integrator.unverified_steps");
+    assert!(s.contains("1001") && s.contains("1000"), "{s}");
+}
+
+/// Steps are accepted on the surrogate's Newton test in runs of at most 8 by default
+/// (`[integrator] unverified_steps`); 0 verifies every step by an evaluation of the residual.
+/// 2 s of the validation walk: fewer residual evaluations, the same walk to 0.1 mm (the tracking
+/// error and the distance), and the energy account closed as well (its error at the robot's
+/// tolerance, 0.05 % of the electrical energy on the 75 s walk, is the integration's: both
+/// within 0.5 % here, over the start's transient).
+#[test]
+fn steps_accepted_on_the_surrogate_default_to_runs_of_eight_and_zero_verifies_every_step() {
+    let run = |steps: Option<usize>| {
+        let mut overrides = vec![Override::new("scenario.duration_s", 2.0)];
+        overrides.extend(steps.map(|n| Override::new("integrator.unverified_steps", n as i64)));
+        let s = overridden(&overrides).unwrap();
+        assert_eq!(s.plant.integrator.unverified_steps, steps.unwrap_or(8));
+        run_scenario(&s, |_| {}).unwrap().summary
+    };
+    let (verified, trusted) = (run(Some(0)), run(None));
+    assert_eq!(verified.unverified_steps, 0);
+    assert!(trusted.unverified_steps > trusted.integration_steps / 4, "{} of {} steps accepted on the surrogate", trusted.unverified_steps, trusted.integration_steps);
+    assert!(trusted.residual_evaluations < verified.residual_evaluations, "{} against {} evaluations", trusted.residual_evaluations, verified.residual_evaluations);
+    let (a, b) = (verified.gait.as_ref().unwrap(), trusted.gait.as_ref().unwrap());
+    eprintln!("distance {} vs {}, XY tracking {} vs {}; evaluations {} vs {}; balance {} vs {}", a.distance_walked_m, b.distance_walked_m, a.tracking_error_xy_max_m, b.tracking_error_xy_max_m, verified.residual_evaluations, trusted.residual_evaluations, verified.energy_balance_error_relative, trusted.energy_balance_error_relative);
+    assert!((a.distance_walked_m - b.distance_walked_m).abs() < 1e-4 && (a.tracking_error_xy_max_m - b.tracking_error_xy_max_m).abs() < 1e-4, "{a:?} vs {b:?}");
+    assert!(verified.energy_balance_error_relative.abs() < 5e-3 && trusted.energy_balance_error_relative.abs() < 5e-3, "{} and {}", verified.energy_balance_error_relative, trusted.energy_balance_error_relative);
 }
 
 /// The robot iterates on its surrogate residual by default (`[integrator] surrogate_iterations`
@@ -307,7 +335,12 @@ fn runs_are_deterministic_and_recorded_with_units() {
     let sm = &a.summary;
     assert_eq!((sm.rows, sm.control_periods), (21, 20));
     assert!((sm.duration_s - 0.2).abs() < 1e-12);
-    assert!(sm.energy_electrical_j > 0.0 && sm.energy_balance_error_relative.abs() < 0.01, "{sm:?}");
+    // A sanity bound: over these 0.2 s the leg's drop makes a transient (kinetic change about
+    // 2.2 J of 3.9 J electrical) whose balance error at the robot's integration tolerance is the
+    // step sequence's, -0.7 % to +1.0 % over 0.2-2 s with every step verified on f or some
+    // accepted on the surrogate (sessions 32-33); the account itself closes to 0.1 % when the
+    // integration converges (`walking_energy_account_closes_when_the_integration_converges`).
+    assert!(sm.energy_electrical_j > 0.0 && sm.energy_balance_error_relative.abs() < 0.02, "{sm:?}");
     let names: Vec<&str> = sm.entries().iter().map(|(n, _)| *n).collect();
     for n in ["duration_s", "wall_time_s", "integration_steps", "energy_electrical_j", "energy_balance_error_j", "body_height_change_m", "max_tracking_error_q_v_m"] {
         assert!(names.contains(&n), "{n} missing from the summary");

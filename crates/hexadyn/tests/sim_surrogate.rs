@@ -1,7 +1,8 @@
 //! Newton iterations on a system's surrogate residual between two evaluations of f
 //! (`System::surrogate_residual`, `NewmarkOptions::surrogate_iterations`): the surrogate changes
 //! how many evaluations of f a step takes, never what the integrator accepts, since every
-//! accepted iterate passes the Newton test on f itself.
+//! accepted iterate passes the Newton test on f itself; and the steps accepted on the surrogate's
+//! own Newton test while a verification by f vouches for it (`NewmarkOptions::unverified_steps`).
 
 use hexadyn::sim::{Layout, Newmark, NewmarkOptions, Order, System};
 
@@ -76,7 +77,12 @@ impl System for BeltBlock {
 
 /// x over 2 s of stick-slip at fixed 1 ms steps, and the integrator's counters.
 fn run(surrogate: Surrogate) -> (Vec<f64>, hexadyn::sim::NewmarkStats) {
-    let options = NewmarkOptions { adaptive: false, h_max: 1e-3, h_min: 1e-9, tolerance: 1e-6, surrogate_iterations: 8, ..Default::default() };
+    run_with(surrogate, 0)
+}
+
+/// [`run`] with at most `unverified_steps` steps in a row accepted on the surrogate's Newton test.
+fn run_with(surrogate: Surrogate, unverified_steps: usize) -> (Vec<f64>, hexadyn::sim::NewmarkStats) {
+    let options = NewmarkOptions { adaptive: false, h_max: 1e-3, h_min: 1e-9, tolerance: 1e-6, surrogate_iterations: 8, unverified_steps, ..Default::default() };
     let mut block = BeltBlock::new(surrogate);
     let mut nm = Newmark::new(&mut block, 0.0, &[0.0], &[0.0], options).unwrap();
     let mut x = Vec::new();
@@ -109,4 +115,27 @@ fn a_surrogate_changes_the_evaluations_not_the_solution() {
     assert_eq!(plain.surrogate_evaluations, 0);
     assert!(with_linearized.surrogate_evaluations > 0 && with_biased.surrogate_evaluations > 0);
     assert!(with_linearized.residual_evaluations < plain.residual_evaluations, "{} vs {}", with_linearized.residual_evaluations, plain.residual_evaluations);
+}
+
+/// Steps accepted on the surrogate's own Newton test (`unverified_steps` 8): the linearized
+/// surrogate earns the trust at its first verification and keeps it, so most steps take one
+/// evaluation of f, and the trajectory stays that of Newton on f alone within what the Newton
+/// test leaves over the run (1e-11 m a step, 2000 steps: 2e-8 m). The biased surrogate fails
+/// every verification: no step is accepted on it, and the trajectory is the one above.
+#[test]
+fn steps_are_accepted_on_the_surrogate_only_while_a_verification_vouches_for_it() {
+    let (reference, plain) = run(Surrogate::None);
+    let (verified, with_verification) = run(Surrogate::Linearized);
+    let (linearized, unverified) = run_with(Surrogate::Linearized, 8);
+    let (biased, with_biased) = run_with(Surrogate::Biased, 8);
+    eprintln!("f alone: {plain:?}\nlinearized, every step verified: {with_verification:?}\nlinearized, 8 unverified: {unverified:?}\nbiased, 8 unverified: {with_biased:?}");
+    let gap = |x: &[f64]| x.iter().zip(&reference).fold(0.0_f64, |a, (x, r)| a.max((x - r).abs()));
+    let (linearized_gap, biased_gap) = (gap(&linearized), gap(&biased));
+    eprintln!("largest gaps to Newton on f alone: linearized {linearized_gap:.2e} m (every step verified {:.2e} m), biased {biased_gap:.2e} m", gap(&verified));
+    assert!(unverified.unverified_steps > plain.steps / 2, "{} of {} steps accepted on the surrogate", unverified.unverified_steps, unverified.steps);
+    assert!(unverified.residual_evaluations < with_verification.residual_evaluations, "{} vs {} evaluations of f", unverified.residual_evaluations, with_verification.residual_evaluations);
+    assert!(linearized_gap < 2e-8, "linearized surrogate: trajectory {linearized_gap} m from Newton on f alone");
+    assert_eq!(with_biased.unverified_steps, 0, "a surrogate whose verifications fail is never trusted");
+    assert!(biased_gap < 1e-5, "biased surrogate: trajectory {biased_gap} m from Newton on f alone");
+    assert_eq!(with_verification.unverified_steps, 0);
 }

@@ -118,6 +118,7 @@ struct RawIntegrator {
     tolerance: Option<f64>,
     h_max_s: Option<f64>,
     surrogate_iterations: Option<usize>,
+    unverified_steps: Option<usize>,
 }
 
 /// `[initial]`.
@@ -231,6 +232,8 @@ const H_MAX_MIN_S: f64 = 1e-5;
 /// `integrator.surrogate_iterations`: at most this many per evaluation of f (the Newton
 /// iterations on f itself are at most 8).
 const SURROGATE_ITERATIONS_MAX: usize = 50;
+/// `integrator.unverified_steps`: at most this many steps in a row accepted on the surrogate.
+const UNVERIFIED_STEPS_MAX: usize = 1000;
 
 /// Checks that `v` is a finite number in `[lo, hi]` (`unit` and `why` go into the message).
 fn in_range(c: &Ctx, field: &str, v: f64, [lo, hi]: [f64; 2], unit: &str, why: &str) -> Result<()> {
@@ -336,6 +339,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         c.check(v <= SURROGATE_ITERATIONS_MAX, "integrator.surrogate_iterations", v as f64, &format!("0 (the thesis' Newton iteration on f alone) to {SURROGATE_ITERATIONS_MAX} Newton iterations on the surrogate residual after each evaluation of f"))
             .map_err(e)?;
         plant.integrator.surrogate_iterations = v;
+    }
+    if let Some(v) = raw.integrator.unverified_steps {
+        c.check(v <= UNVERIFIED_STEPS_MAX, "integrator.unverified_steps", v as f64, &format!("0 (every step verified by an evaluation of the residual, the thesis' acceptance) to {UNVERIFIED_STEPS_MAX} steps in a row accepted on the surrogate's Newton test"))
+            .map_err(e)?;
+        plant.integrator.unverified_steps = v;
     }
 
     // Control mode and the walking set-up: in gait mode the initial joints come from the gait.

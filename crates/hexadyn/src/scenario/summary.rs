@@ -39,6 +39,8 @@ pub struct Summary {
     /// feet and joints, no kinematics): the Newton iterations between two of f and the resets
     /// of q'' at the control instants.
     pub surrogate_evaluations: u64,
+    /// Steps accepted on the surrogate's Newton test (`NewmarkOptions::unverified_steps`).
+    pub unverified_steps: u64,
     pub jacobian_evaluations: u64,
     pub factorizations: u64,
     /// Body height Z at the start (after settling and offset).
@@ -100,6 +102,7 @@ impl Summary {
             ("newton_iterations", Count(self.newton_iterations)),
             ("residual_evaluations", Count(self.residual_evaluations)),
             ("surrogate_evaluations", Count(self.surrogate_evaluations)),
+            ("unverified_steps", Count(self.unverified_steps)),
             ("jacobian_evaluations", Count(self.jacobian_evaluations)),
             ("factorizations", Count(self.factorizations)),
             ("initial_body_height_m", Number(self.initial_body_height_m)),
@@ -292,6 +295,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         newton_iterations: n.newton_iterations as u64,
         residual_evaluations: n.residual_evaluations as u64,
         surrogate_evaluations: n.surrogate_evaluations as u64,
+        unverified_steps: n.unverified_steps as u64,
         jacobian_evaluations: n.jacobian_evaluations as u64,
         factorizations: n.factorizations as u64,
         initial_body_height_m: q0[2],
