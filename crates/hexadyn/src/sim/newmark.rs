@@ -64,8 +64,8 @@ pub struct NewmarkOptions {
     /// last iterate, while the surrogate is trusted (`SurrogateTrust`): the evaluation of f that
     /// last followed a converged surrogate iteration passed the Newton test itself, and no step
     /// was rejected since. 0 (the default): every step passes the Newton test on f, the thesis'
-    /// iteration. The robot's plant takes [`crate::robot::PlantOptions`]'s choice; see
-    /// docs/performance-log.md, session 33, for what it costs in accuracy.
+    /// iteration. The robot's plant takes 8 (`PlantOptions::from_description`);
+    /// docs/performance-log.md, session 33, measures what the verifications find.
     pub unverified_steps: usize,
 }
 
