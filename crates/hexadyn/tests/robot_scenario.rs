@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, SummaryValue};
+use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
+use hexadyn::sim::NewmarkOptions;
 use hexadyn::description::AMRU5_TOML;
 use hexadyn::hexapod::Joint;
 
@@ -132,6 +133,19 @@ fn errors_name_file_line_field_value_and_allowed() {
     assert!(s.contains("1001") && s.contains("1000"), "{s}");
 }
 
+/// 2 s of the validation walk with the integrator option `field` (read back by `option`) at 0
+/// and at its default, 8: the two summaries.
+fn two_seconds_at_zero_and_default(field: &str, option: impl Fn(&NewmarkOptions) -> usize) -> (Summary, Summary) {
+    let run = |value: Option<usize>| {
+        let mut overrides = vec![Override::new("scenario.duration_s", 2.0)];
+        overrides.extend(value.map(|n| Override::new(field, n as i64)));
+        let s = overridden(&overrides).unwrap();
+        assert_eq!(option(&s.plant.integrator), value.unwrap_or(8), "{field}");
+        run_scenario(&s, |_| {}).unwrap().summary
+    };
+    (run(Some(0)), run(None))
+}
+
 /// Steps are accepted on the surrogate's Newton test in runs of at most 8 by default
 /// (`[integrator] unverified_steps`); 0 verifies every step by an evaluation of the residual.
 /// 2 s of the validation walk: fewer residual evaluations, the same walk to 0.1 mm (the tracking
@@ -140,14 +154,7 @@ fn errors_name_file_line_field_value_and_allowed() {
 /// within 0.5 % here, over the start's transient).
 #[test]
 fn steps_accepted_on_the_surrogate_default_to_runs_of_eight_and_zero_verifies_every_step() {
-    let run = |steps: Option<usize>| {
-        let mut overrides = vec![Override::new("scenario.duration_s", 2.0)];
-        overrides.extend(steps.map(|n| Override::new("integrator.unverified_steps", n as i64)));
-        let s = overridden(&overrides).unwrap();
-        assert_eq!(s.plant.integrator.unverified_steps, steps.unwrap_or(8));
-        run_scenario(&s, |_| {}).unwrap().summary
-    };
-    let (verified, trusted) = (run(Some(0)), run(None));
+    let (verified, trusted) = two_seconds_at_zero_and_default("integrator.unverified_steps", |o| o.unverified_steps);
     assert_eq!(verified.unverified_steps, 0);
     assert!(trusted.unverified_steps > trusted.integration_steps / 4, "{} of {} steps accepted on the surrogate", trusted.unverified_steps, trusted.integration_steps);
     assert!(trusted.residual_evaluations < verified.residual_evaluations, "{} against {} evaluations", trusted.residual_evaluations, verified.residual_evaluations);
@@ -163,14 +170,7 @@ fn steps_accepted_on_the_surrogate_default_to_runs_of_eight_and_zero_verifies_ev
 /// distance).
 #[test]
 fn surrogate_iterations_default_to_eight_and_zero_iterates_on_f_alone() {
-    let run = |iterations: Option<usize>| {
-        let mut overrides = vec![Override::new("scenario.duration_s", 2.0)];
-        overrides.extend(iterations.map(|n| Override::new("integrator.surrogate_iterations", n as i64)));
-        let s = overridden(&overrides).unwrap();
-        assert_eq!(s.plant.integrator.surrogate_iterations, iterations.unwrap_or(8));
-        run_scenario(&s, |_| {}).unwrap().summary
-    };
-    let (plain, surrogate) = (run(Some(0)), run(None));
+    let (plain, surrogate) = two_seconds_at_zero_and_default("integrator.surrogate_iterations", |o| o.surrogate_iterations);
     assert_eq!(plain.surrogate_evaluations, 0);
     assert!(surrogate.surrogate_evaluations > 0 && surrogate.residual_evaluations < plain.residual_evaluations, "{} and {} surrogate against {} evaluations", surrogate.residual_evaluations, surrogate.surrogate_evaluations, plain.residual_evaluations);
     let (a, b) = (plain.gait.unwrap(), surrogate.gait.unwrap());
