@@ -62,8 +62,8 @@ pub struct NewmarkOptions {
     pub surrogate_iterations: usize,
     /// Steps accepted in a row on the Newton test of the surrogate, without evaluating f at their
     /// last iterate, while the surrogate is trusted (`SurrogateTrust`): the evaluation of f that
-    /// last followed a converged surrogate iteration passed the Newton test itself, and no step
-    /// was rejected since. 0 (the default): every step passes the Newton test on f, the thesis'
+    /// last followed a converged surrogate iteration passed the Newton test itself, and no
+    /// Newton iteration failed and no step was rejected since. 0 (the default): every step passes the Newton test on f, the thesis'
     /// iteration. The robot's plant takes 8 (`PlantOptions::from_description`);
     /// docs/performance-log.md, session 33, measures what the verifications find.
     pub unverified_steps: usize,
@@ -132,9 +132,9 @@ pub struct NewmarkStats {
 /// model error, which the evaluation of f after a converged surrogate iteration measures: on the
 /// 75 s LuGre walk its Newton correction is a median 0.02 and at most 13 times the Newton
 /// tolerance, itself 1 % of the error tolerance of Eq. 3.15 (docs/performance-log.md, session
-/// 33). Trust is earned by such a verification that passes, and lost on a verification that fails
-/// and on every rejected step (touchdowns, lift-offs and velocity reversals, where the
-/// surrogate's base is furthest from the step's end).
+/// 33). Trust is earned by such a verification that passes, and lost on a verification that fails,
+/// on every Newton failure and on every rejected step (touchdowns, lift-offs and velocity
+/// reversals, where the surrogate's base is furthest from the step's end).
 #[derive(Clone, Copy, Debug, Default)]
 struct SurrogateTrust {
     verified: bool,
@@ -172,7 +172,8 @@ pub struct Newmark {
     broyden: Broyden,
     /// The system keeps its last evaluation of f as its surrogate's base
     /// ([`System::keep_surrogate_base`]): after an accepted step, the evaluation at its last
-    /// Newton iterate, within the Newton test of the state.
+    /// Newton iterate on f, within the Newton test of the state, or (a step accepted on the
+    /// surrogate) the one its surrogate iterations started from.
     surrogate_base: bool,
     trust: SurrogateTrust,
     work: Work,
