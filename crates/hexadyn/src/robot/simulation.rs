@@ -132,11 +132,11 @@ impl PlantOptions {
         let slow_contraction = if model.friction == FrictionModel::LuGre { 0.9 } else { 0.5 };
         // Newton goes on on the robot's surrogate residual between evaluations of f
         // (`robot/model/surrogate.rs`), at most this many iterations each. INTERPRETATION: the
-        // thesis iterates on f alone (Section 3.3.2); with `unverified_steps` 0 every accepted step
-        // passes the Newton test on f. The 75 s LuGre walk takes 31 810, 27 035, 25 865 and 25 697 evaluations of f
-        // with 2, 4, 8 and 16 (44 416 on f alone), its figures against a converged run
-        // (tolerance 0.01, h_max 1 ms) as close as on f alone: electrical energy +0.20 % both
-        // (docs/performance-log.md, sessions 29-30).
+        // thesis iterates on f alone (Section 3.3.2); with `unverified_steps` 0 every accepted
+        // step passes the Newton test on f. The 75 s LuGre walk takes 31 810, 27 035, 25 865 and
+        // 25 697 evaluations of f with 2, 4, 8 and 16 (44 416 on f alone), its figures against a
+        // converged run (tolerance 0.01, h_max 1 ms) as close as on f alone: electrical energy
+        // +0.20 % both (docs/performance-log.md, sessions 29-30).
         let surrogate_iterations = 8;
         // A step whose surrogate iteration converges is accepted on it, without the evaluation of
         // f that would verify it, in runs of at most this many steps while the last verification

@@ -63,9 +63,10 @@ pub struct NewmarkOptions {
     /// Steps accepted in a row on the Newton test of the surrogate, without evaluating f at their
     /// last iterate, while the surrogate is trusted (`SurrogateTrust`): the evaluation of f that
     /// last followed a converged surrogate iteration passed the Newton test itself, and no
-    /// Newton iteration failed and no step was rejected since. 0 (the default): every step passes the Newton test on f, the thesis'
-    /// iteration. The robot's plant takes 8 (`PlantOptions::from_description`);
-    /// docs/performance-log.md, session 33, measures what the verifications find.
+    /// Newton iteration failed and no step was rejected since. 0 (the default): every step
+    /// passes the Newton test on f, the thesis' iteration. The robot's plant takes 8
+    /// (`PlantOptions::from_description`); docs/performance-log.md, session 33, measures what
+    /// the verifications find.
     pub unverified_steps: usize,
 }
 
@@ -143,8 +144,12 @@ struct SurrogateTrust {
 }
 
 impl SurrogateTrust {
-    fn accepts(&self, limit: usize) -> bool {
-        self.verified && self.unverified < limit
+    /// Whether the step whose surrogate iteration converged is accepted on it: trusted, and
+    /// fewer than `limit` steps accepted so since the last verification (counted when true).
+    fn accept(&mut self, limit: usize) -> bool {
+        let accepted = self.verified && self.unverified < limit;
+        self.unverified += usize::from(accepted);
+        accepted
     }
     /// The Newton test of f after a converged surrogate iteration: passed or not.
     fn verify(&mut self, passed: bool) {
@@ -558,8 +563,7 @@ impl Newmark {
                 }
                 previous = norm;
                 if self.surrogate_base && self.iterate_on_surrogate(sys, h, t_new, &test, norm) {
-                    if self.trust.accepts(self.options.unverified_steps) {
-                        self.trust.unverified += 1;
+                    if self.trust.accept(self.options.unverified_steps) {
                         self.stats.unverified_steps += 1;
                         self.update_kinematics(h);
                         return Ok(self.accept_or_reject(sys, h));
