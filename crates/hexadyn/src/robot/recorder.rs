@@ -107,7 +107,13 @@ impl fmt::Display for RowMismatch {
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct Recorder {
-    series: TimeSeries,
+    /// The columns, defined by the first row; their values are handed out by
+    /// [`Recorder::take_chunk`] and [`Recorder::finish`].
+    columns: Vec<Column>,
+    /// The values of the rows since the last chunk, row after row: one push per value instead of
+    /// one into each column's vector (a row of the validation walk has about 300 values),
+    /// transposed into the columns when handed out.
+    values: Vec<f64>,
     rows: usize,
     cursor: usize,
 }
@@ -122,11 +128,11 @@ impl Recorder {
     pub fn put(&mut self, value: f64, spec: impl FnOnce() -> (String, &'static str, String)) {
         if self.rows == 0 {
             let (name, unit, description) = spec();
-            debug_assert!(self.series.column(&name).is_none(), "duplicate column {name}");
-            self.series.columns.push(Column { name, unit, description, values: Vec::new() });
+            debug_assert!(self.columns.iter().all(|c| c.name != name), "duplicate column {name}");
+            self.columns.push(Column { name, unit, description, values: Vec::new() });
         }
-        if let Some(c) = self.series.columns.get_mut(self.cursor) {
-            c.values.push(value);
+        if self.cursor < self.columns.len() {
+            self.values.push(value);
         }
         self.cursor += 1;
     }
@@ -136,7 +142,7 @@ impl Recorder {
     /// # Panics
     /// If the row did not put exactly the columns of the first row (a bug of the caller).
     pub fn end_row(&mut self) {
-        let expected = self.series.columns.len();
+        let expected = self.columns.len();
         if self.cursor != expected {
             panic!("{}", RowMismatch { row: self.rows, expected, got: self.cursor });
         }
@@ -148,24 +154,26 @@ impl Recorder {
         self.rows
     }
 
-    pub fn series(&self) -> &TimeSeries {
-        &self.series
-    }
-
-    pub fn finish(self) -> TimeSeries {
-        self.series
+    /// The rows recorded so far as a time series.
+    pub fn finish(mut self) -> TimeSeries {
+        self.take_chunk()
     }
 
     /// Rows recorded since the last [`Recorder::take_chunk`] (or the start).
     pub fn buffered(&self) -> usize {
-        self.series.len()
+        self.values.len().checked_div(self.columns.len()).unwrap_or(0)
     }
 
     /// Takes the rows recorded since the last call (the columns with their values so far) and
     /// goes on recording into empty columns: a long run handed out in chunks holds one chunk at
     /// a time.
     pub fn take_chunk(&mut self) -> TimeSeries {
-        let columns = self.series.columns.iter_mut().map(|c| Column { name: c.name.clone(), unit: c.unit, description: c.description.clone(), values: std::mem::take(&mut c.values) }).collect();
+        let width = self.columns.len();
+        // Column k is every width-th value from k: read in order of the columns, the rows of
+        // eight neighbouring columns share their cache lines.
+        let values = &self.values;
+        let columns = self.columns.iter().enumerate().map(|(k, c)| Column { name: c.name.clone(), unit: c.unit, description: c.description.clone(), values: values[k.min(values.len())..].iter().step_by(width).copied().collect() }).collect();
+        self.values.clear();
         TimeSeries { columns }
     }
 }

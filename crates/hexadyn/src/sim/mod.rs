@@ -2,6 +2,7 @@
 //! (Eq. 3.1), their implicit Newmark integration with Newton-Raphson (Eq. 3.7-3.15), static
 //! equilibrium and linearization (Eq. 3.16-3.17).
 
+mod bordered;
 mod broyden;
 mod error;
 mod factorization;

@@ -267,7 +267,7 @@ impl Newmark {
         if !direct {
             self.stats.jacobian_evaluations += 1;
         }
-        self.mass_lu = Factorization::new(m, &self.first_order(sys));
+        self.mass_lu = Factorization::new(m, &self.first_order(sys), self.mass_lu.as_ref());
         self.mass_outdated = false;
         self.stats.factorizations += 1;
         if self.mass_lu.is_none() {
@@ -310,7 +310,7 @@ impl Newmark {
     /// [`Self::reset_accelerations`].
     pub fn reset_accelerations_after_input_jump<S: System + ?Sized>(&mut self, sys: &mut S, previous: &[f64]) -> Result<(), SimError> {
         if let (true, Some(jacobian)) = (self.mass_outdated, &self.jacobian) {
-            if let Some(lu) = Factorization::new(jacobian.m.clone(), &self.first_order(sys)) {
+            if let Some(lu) = Factorization::new(jacobian.m.clone(), &self.first_order(sys), self.mass_lu.as_ref()) {
                 self.mass_lu = Some(lu);
                 self.stats.factorizations += 1;
             }
@@ -449,7 +449,7 @@ impl Newmark {
         let matrix: DMatrix<f64> = jac.iteration_matrix(self.options.beta, self.options.gamma, h);
         let first_order = self.first_order(sys);
         self.stats.factorizations += 1;
-        let Some(lu) = Factorization::new(matrix, &first_order) else {
+        let Some(lu) = Factorization::new(matrix, &first_order, self.lu.as_ref().map(|(lu, _)| lu)) else {
             return Err(SimError::Singular { what: "Newmark iteration", t: self.state.t });
         };
         self.lu = Some((lu, h));
