@@ -77,8 +77,12 @@ impl EnergyAccount {
             p.contact[leg] = c.absorbed_power;
         }
         self.contact_energy = out.contact.iter().map(|c| c.elastic_energy).sum();
-        self.kinetic = mbs::kinetic_energy(&m.mechanics.model, robot.data());
-        self.potential = mbs::potential_energy(&m.mechanics.model, robot.data());
+        // At a control instant the reset after the input jump moves q'' alone: (q, q'), and with
+        // them the kinetic and potential energies, are those accumulated last, at the same t.
+        if self.powers.as_ref().is_none_or(|prev| prev.t != state.t) {
+            self.kinetic = mbs::kinetic_energy(&m.mechanics.model, robot.data());
+            self.potential = mbs::potential_energy(&m.mechanics.model, robot.data());
+        }
         if let Some(prev) = &self.powers {
             let h = 0.5 * (p.t - prev.t);
             for k in 0..JOINTS {

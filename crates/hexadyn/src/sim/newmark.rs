@@ -1,5 +1,7 @@
 //! Implicit Newmark integration with Newton-Raphson on q''(t+h) (thesis Eq. 3.7-3.15).
 
+use std::sync::Arc;
+
 use nalgebra::{DMatrix, DVector};
 
 use super::broyden::Broyden;
@@ -181,6 +183,8 @@ pub struct Newmark {
     /// surrogate) the one its surrogate iterations started from.
     surrogate_base: bool,
     trust: SurrogateTrust,
+    /// What the Newton tests of all step sizes share, built once.
+    newton_scales: Option<Arc<NewtonScales>>,
     work: Work,
 }
 
@@ -220,6 +224,7 @@ impl Newmark {
             broyden: Broyden::default(),
             surrogate_base: false,
             trust: SurrogateTrust::default(),
+            newton_scales: None,
             stats: NewmarkStats::default(),
             work: Work { f: vec![0.0; n], q: DVector::zeros(n), qd: DVector::zeros(n), qdd: DVector::zeros(n), weight_q: DVector::zeros(n), dx_previous: DVector::zeros(n) },
         };
@@ -333,11 +338,11 @@ impl Newmark {
         }
         check_finite(sys, t, None, &self.work.f)?;
         self.weights(sys);
+        let test = self.newton_test(sys, self.h);
         let lu = self.mass_lu.as_ref().expect("factorized");
         if let Some(dx) = lu.solve(&self.work.f) {
-            let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, self.h);
             let consistent = &self.state.qdd - &dx;
-            if test.converged(test.norm(&dx, &self.work.weight_q), &dx, &consistent) {
+            if test.converged(test.norm(&dx), &dx, &consistent) {
                 self.state.qdd = consistent;
                 return Ok(());
             }
@@ -359,7 +364,7 @@ impl Newmark {
     fn consistent_accelerations<S: System + ?Sized>(&mut self, sys: &mut S, contraction: f64) -> Result<bool, SimError> {
         let t = self.state.t;
         self.weights(sys);
-        let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, self.h);
+        let test = self.newton_test(sys, self.h);
         let mut previous = f64::INFINITY;
         for _ in 0..self.options.max_iterations {
             sys.residual(t, self.state.q.as_slice(), self.state.qd.as_slice(), self.state.qdd.as_slice(), &mut self.work.f);
@@ -371,7 +376,7 @@ impl Newmark {
                 return Ok(false);
             };
             self.state.qdd -= &dx;
-            let norm = test.norm(&dx, &self.work.weight_q);
+            let norm = test.norm(&dx);
             if test.converged(norm, &dx, &self.state.qdd) {
                 return Ok(true);
             }
@@ -424,6 +429,15 @@ impl Newmark {
         // that `state().t` is exactly the requested instant.
         self.state.t = t_end;
         Ok(())
+    }
+
+    /// The Newton test of a step of size h, with the weights of [`Self::weights`].
+    fn newton_test<S: System + ?Sized>(&mut self, sys: &S, h: f64) -> NewtonTest {
+        let scales = match &self.newton_scales {
+            Some(scales) if scales.is_for(&self.options, &self.work.weight_q) => Arc::clone(scales),
+            _ => Arc::clone(self.newton_scales.insert(Arc::new(NewtonScales::new(&self.options, &sys.layout().orders, &self.work.weight_q)))),
+        };
+        NewtonTest::new(scales, h)
     }
 
     fn weights<S: System + ?Sized>(&mut self, sys: &S) {
@@ -501,7 +515,7 @@ impl Newmark {
         let t_new = self.state.t + h;
         self.weights(sys);
         self.jacobian_fresh = false;
-        let test = NewtonTest::new(&self.options, &sys.layout().orders, &self.work.weight_q, h);
+        let test = self.newton_test(sys, h);
         'attempt: loop {
             // Predictor (a missing Jacobian is evaluated there).
             self.predict(sys);
@@ -527,7 +541,7 @@ impl Newmark {
                 self.surrogate_base = self.options.surrogate_iterations > 0 && sys.keep_surrogate_base(self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &self.work.f);
                 let Some(dx) = self.correction(&test) else { break };
                 self.work.qdd -= &dx;
-                let norm = test.norm(&dx, &self.work.weight_q);
+                let norm = test.norm(&dx);
                 if !norm.is_finite() {
                     break;
                 }
@@ -540,7 +554,7 @@ impl Newmark {
                     return Ok(self.accept_or_reject(sys, h));
                 }
                 let contraction = norm / previous;
-                if previous.is_finite() && contraction > self.options.slow_contraction && test.dot(&dx, &self.work.dx_previous, &self.work.weight_q) < -REVERSAL * norm * previous {
+                if previous.is_finite() && contraction > self.options.slow_contraction && test.dot(&dx, &self.work.dx_previous) < -REVERSAL * norm * previous {
                     // The correction turns back on the previous one without contracting: Newton
                     // jumps across a kink (|q'| in a LuGre bristle rate, Eq. 3.85; the linear
                     // zone of the ground friction) and back, with a Jacobian from one side of
@@ -601,8 +615,7 @@ impl Newmark {
     fn correction(&mut self, test: &NewtonTest) -> Option<DVector<f64>> {
         let (lu, _) = self.lu.as_ref().expect("factorized");
         let newton = lu.solve(&self.work.f)?;
-        let weight = &self.work.weight_q;
-        Some(self.broyden.step(newton, |a, b| test.dot(a, b, weight)))
+        Some(self.broyden.step(newton, |a, b| test.dot(a, b)))
     }
 
     /// Newton iterations on the system's surrogate residual (`System::surrogate_residual`),
@@ -622,7 +635,7 @@ impl Newmark {
             sys.surrogate_residual(t_new, self.work.q.as_slice(), self.work.qd.as_slice(), self.work.qdd.as_slice(), &mut self.work.f);
             self.stats.surrogate_evaluations += 1;
             let Some(dx) = self.correction(test) else { break };
-            let norm = test.norm(&dx, &self.work.weight_q);
+            let norm = test.norm(&dx);
             // A non-finite surrogate gives a NaN norm, which fails the first test too.
             if !(norm <= SURROGATE_GROWTH * bound) || (iteration > 1 && norm > previous) {
                 break;
@@ -704,52 +717,77 @@ impl Newmark {
     }
 }
 
+/// What the Newton test of every step size shares: per coordinate, the factors of its powers of
+/// h, second-order coordinates in the `second` entries and first-order ones in the `first`
+/// entries (zero in the other), for the options and the weights (inverse error scales) they were
+/// built for.
+struct NewtonScales {
+    options: NewmarkOptions,
+    weight: DVector<f64>,
+    /// (β w_i)² / n and (γ w_i)² / n: the metric is h⁴ second_i + h² first_i.
+    metric: (Vec<f64>, Vec<f64>),
+    /// newton_tolerance · tolerance / (w_i β) and / (w_i γ): the floor at h_ref is
+    /// second_i / h_ref² + first_i / h_ref.
+    floor: (Vec<f64>, Vec<f64>),
+}
+
+impl NewtonScales {
+    fn new(options: &NewmarkOptions, orders: &[Order], weight: &DVector<f64>) -> Self {
+        let n = orders.len() as f64;
+        let converge_at = options.newton_tolerance * options.tolerance;
+        let split = |value: &dyn Fn(f64, f64) -> f64| -> (Vec<f64>, Vec<f64>) {
+            let of = |order: Order| orders.iter().zip(weight.iter()).map(|(o, &w)| if *o == order { value(w, if order == Order::Second { options.beta } else { options.gamma }) } else { 0.0 }).collect();
+            (of(Order::Second), of(Order::First))
+        };
+        NewtonScales { options: options.clone(), weight: weight.clone(), metric: split(&|w, c| (c * w).powi(2) / n), floor: split(&|w, c| converge_at / w / c) }
+    }
+
+    fn is_for(&self, options: &NewmarkOptions, weight: &DVector<f64>) -> bool {
+        self.options == *options && self.weight == *weight
+    }
+}
+
 /// The Newton convergence test of a step of size h.
 struct NewtonTest {
+    scales: Arc<NewtonScales>,
     /// Newton corrections are measured on the integrated quantity: q (βh² Δq'') for
-    /// second-order coordinates and q' (γh Δq'') for first-order ones.
-    unit: Vec<f64>,
+    /// second-order coordinates and q' (γh Δq'') for first-order ones, in units of their scales:
+    /// the mean square of the weighted correction is Σ (h⁴ second_i + h² first_i) Δq''_i².
+    h4: f64,
+    h2: f64,
     /// The last correction must also be small against q'' itself (`newton_tolerance` relative),
     /// with an absolute floor equal to what the test on the integrated quantities allows at
-    /// h_max: as h → 0 that test alone accepts any bounded q'' (βh² Δq'' vanishes), so an
-    /// iteration that does not converge at all, e.g. on a residual without a root, would pass
-    /// silently.
-    floor: Vec<f64>,
+    /// h_ref = h_max: as h → 0 that test alone accepts any bounded q'' (βh² Δq'' vanishes), so
+    /// an iteration that does not converge at all, e.g. on a residual without a root, would pass
+    /// silently. 1 / h_ref² and 1 / h_ref.
+    inverse_ref: (f64, f64),
     converge_at: f64,
     relative: f64,
 }
 
 impl NewtonTest {
-    fn new(options: &NewmarkOptions, orders: &[Order], weight: &DVector<f64>, h: f64) -> Self {
-        let (b, g) = (options.beta, options.gamma);
-        let unit_at = |o: &Order, h: f64| match o {
-            Order::Second => b * h * h,
-            Order::First => g * h,
-        };
-        let converge_at = options.newton_tolerance * options.tolerance;
+    fn new(scales: Arc<NewtonScales>, h: f64) -> Self {
+        let options = &scales.options;
         let h_ref = if options.h_max.is_finite() { options.h_max.max(h) } else { h };
-        NewtonTest {
-            unit: orders.iter().map(|o| unit_at(o, h)).collect(),
-            floor: orders.iter().zip(weight.iter()).map(|(o, w)| converge_at / w / unit_at(o, h_ref)).collect(),
-            converge_at,
-            relative: options.newton_tolerance,
-        }
+        let (converge_at, relative) = (options.newton_tolerance * options.tolerance, options.newton_tolerance);
+        NewtonTest { h4: h.powi(4), h2: h * h, inverse_ref: (h_ref.powi(-2), 1.0 / h_ref), converge_at, relative, scales }
     }
 
     /// RMS of the correction of the integrated quantities, in units of their scales.
-    fn norm(&self, dx: &DVector<f64>, weight: &DVector<f64>) -> f64 {
-        let n = dx.len();
-        (0..n).map(|i| (dx[i] * self.unit[i] * weight[i]).powi(2)).sum::<f64>().sqrt() / (n as f64).sqrt()
+    fn norm(&self, dx: &DVector<f64>) -> f64 {
+        self.dot(dx, dx).sqrt()
     }
 
     /// Scalar product of two corrections in the metric of [`Self::norm`].
-    fn dot(&self, a: &DVector<f64>, b: &DVector<f64>, weight: &DVector<f64>) -> f64 {
-        let n = a.len();
-        (0..n).map(|i| a[i] * b[i] * (self.unit[i] * weight[i]).powi(2)).sum::<f64>() / n as f64
+    fn dot(&self, a: &DVector<f64>, b: &DVector<f64>) -> f64 {
+        let (second, first) = &self.scales.metric;
+        let products = a.as_slice().iter().zip(b.as_slice()).zip(second.iter().zip(first));
+        products.map(|((x, y), (s, f))| x * y * (self.h4 * s + self.h2 * f)).sum()
     }
 
     fn converged(&self, norm: f64, dx: &DVector<f64>, qdd: &DVector<f64>) -> bool {
-        norm <= self.converge_at && (0..dx.len()).all(|i| dx[i].abs() <= self.relative * qdd[i].abs() + self.floor[i])
+        let (second, first) = &self.scales.floor;
+        norm <= self.converge_at && (0..dx.len()).all(|i| dx[i].abs() <= self.relative * qdd[i].abs() + second[i] * self.inverse_ref.0 + first[i] * self.inverse_ref.1)
     }
 }
 
