@@ -7,7 +7,9 @@
 //! sparse. J x = r is then solved exactly through the Schur complement S = A − B D⁻¹ C:
 //! S x_a = r_a − B D⁻¹ r_t, x_t = D⁻¹ (r_t − C x_a). For the 42-DOF model (24 multibody
 //! coordinates, 18 bristles) the LU is that of a 24 × 24 matrix instead of 42 × 42, about a
-//! fifth of the work, and each solve about half.
+//! fifth of the work, and each solve about half. S (or J when nothing is eliminated) is then
+//! solved by its bordered block-diagonal elimination when the tree's zeros allow it
+//! (`bordered.rs`), else by its LU with partial pivoting.
 
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 
@@ -125,7 +127,7 @@ impl Factorization {
         // entry, so that the test is the stricter for it.
         let kept = (0..n).filter(|&r| !first_order[r]).fold(0.0_f64, |m, r| m.max(j[(r, r)].abs()));
         let t: Vec<usize> = (0..n).filter(|&i| first_order[i] && eliminable(&j, first_order, i, kept)).collect();
-        // Nothing to eliminate, or nothing left (a diagonal J): the full LU.
+        // Nothing to eliminate, or nothing left (a diagonal J): J itself is solved.
         if t.is_empty() || t.len() == n {
             let all: Vec<usize> = (0..n).collect();
             return Dense::new(j, &all, previous).map(|lu| Factorization { kind: Kind::Full(lu) });
