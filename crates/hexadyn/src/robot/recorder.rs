@@ -172,7 +172,7 @@ impl Recorder {
         // Column k is every width-th value from k: read in order of the columns, the rows of
         // eight neighbouring columns share their cache lines.
         let values = &self.values;
-        let columns = self.columns.iter().enumerate().map(|(k, c)| Column { name: c.name.clone(), unit: c.unit, description: c.description.clone(), values: values[k.min(values.len())..].iter().step_by(width).copied().collect() }).collect();
+        let columns = self.columns.iter().enumerate().map(|(k, c)| Column { name: c.name.clone(), unit: c.unit, description: c.description.clone(), values: values.iter().skip(k).step_by(width).copied().collect() }).collect();
         self.values.clear();
         TimeSeries { columns }
     }

@@ -9,6 +9,7 @@ mod factorization;
 mod jacobian;
 mod linearize;
 mod newmark;
+mod newton_test;
 mod statics;
 mod system;
 
