@@ -272,8 +272,7 @@ impl LegKinematics {
     /// Planar foot F(q_v, q_h) and its closed-form derivatives.
     fn planar(&self, q_v: f64, q_h: f64) -> PlanarFoot {
         let g = &self.pantograph;
-        let (p0, _) = g.dependent_parameters(q_v, q_h);
-        let (s, c) = p0.sin_cos();
+        let (s, c) = g.p0_sin_cos(q_v, q_h);
         let u0 = Vector2::new(c, s);
         let n0 = Vector2::new(-s, c);
         let a = Vector2::new(0.0, q_v);
@@ -297,7 +296,7 @@ impl LegKinematics {
     /// k(q) of Eq. 7.6: the foot F in the leg frame for q = (q_r, q_v, q_h).
     pub fn foot(&self, q: &Vector3<f64>) -> Vector3<f64> {
         let f = self.pantograph.foot(q[1], q[2]);
-        rz_minus(q[0], &(self.crossing + Vector3::new(f.x, 0.0, f.y)))
+        RzMinus::new(q[0]).apply(&(self.crossing + Vector3::new(f.x, 0.0, f.y)))
     }
 
     /// J = ∂k/∂q of Eq. 7.8-7.9, columns (q_r, q_v, q_h).
@@ -308,11 +307,12 @@ impl LegKinematics {
     /// k(q) and J(q) together.
     pub fn foot_and_jacobian(&self, q: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
         let pf = self.planar(q[1], q[2]);
-        let p = rz_minus(q[0], &(self.crossing + Vector3::new(pf.f.x, 0.0, pf.f.y)));
+        let rz = RzMinus::new(q[0]);
+        let p = rz.apply(&(self.crossing + Vector3::new(pf.f.x, 0.0, pf.f.y)));
         // ∂/∂q_r R_z(−q_r) s = −e_z × p.
         let jr = Vector3::new(p.y, -p.x, 0.0);
-        let jv = rz_minus(q[0], &Vector3::new(pf.d_qv.x, 0.0, pf.d_qv.y));
-        let jh = rz_minus(q[0], &Vector3::new(pf.d_qh.x, 0.0, pf.d_qh.y));
+        let jv = rz.apply(&Vector3::new(pf.d_qv.x, 0.0, pf.d_qv.y));
+        let jh = rz.apply(&Vector3::new(pf.d_qh.x, 0.0, pf.d_qh.y));
         (p, Matrix3::from_columns(&[jr, jv, jh]))
     }
 
@@ -417,7 +417,7 @@ impl LegKinematics {
         let mut best_e = (best.1 - target).norm();
         let mut updates = 0;
         // Azimuth of the target for q_r: azimuth of the foot is −q_r + atan2(s_y, s_x).
-        let s = rz_minus(-q0[0], &best.1);
+        let s = RzMinus::new(-q0[0]).apply(&best.1);
         let q_r_aim = (s.y.atan2(s.x) - target.y.atan2(target.x)).clamp(self.limits.lower[0], self.limits.upper[0]);
         let aim = target.xy().norm() > 1e-9;
         for code in 0..27usize {
@@ -522,10 +522,24 @@ impl LegKinematics {
     }
 }
 
-/// R_z(−q_r) v.
-fn rz_minus(q_r: f64, v: &Vector3<f64>) -> Vector3<f64> {
-    let (s, c) = q_r.sin_cos();
-    Vector3::new(c * v.x + s * v.y, -s * v.x + c * v.y, v.z)
+/// R_z(−q_r), from the sine and cosine of q_r taken once for the vectors it turns.
+#[derive(Clone, Copy)]
+struct RzMinus {
+    sin: f64,
+    cos: f64,
+}
+
+impl RzMinus {
+    fn new(q_r: f64) -> Self {
+        let (sin, cos) = q_r.sin_cos();
+        RzMinus { sin, cos }
+    }
+
+    /// R_z(−q_r) v.
+    fn apply(&self, v: &Vector3<f64>) -> Vector3<f64> {
+        let (s, c) = (self.sin, self.cos);
+        Vector3::new(c * v.x + s * v.y, -s * v.x + c * v.y, v.z)
+    }
 }
 
 #[cfg(test)]

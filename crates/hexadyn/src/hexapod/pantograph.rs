@@ -35,6 +35,15 @@ impl PantographGeometry {
         (p0, p1)
     }
 
+    /// (sin p0, cos p0) of Eq. 3.62 without the angle (see [`p0_sin_cos`]): what the foot
+    /// needs, at no arc cosine, arc sine, sine or cosine.
+    pub fn p0_sin_cos(&self, q_v: f64, q_h: f64) -> (f64, f64) {
+        let (c, l) = (self.c, self.l1);
+        let k2 = q_v * q_v + q_h * q_h;
+        let k = k2.sqrt();
+        p0_sin_cos((k2 + c * c - l * l) / (k * (2.0 * c)), q_v / k)
+    }
+
     /// True when the triangle A-B-D closes: |c − l| < k < c + l.
     pub fn closes(&self, q_v: f64, q_h: f64) -> bool {
         let k = q_v.hypot(q_h);
@@ -43,10 +52,10 @@ impl PantographGeometry {
 
     /// Points of the linkage in the leg plane for (q_v, q_h): A, B, C, D, E, F.
     pub fn points(&self, q_v: f64, q_h: f64) -> [Vector2<f64>; 6] {
-        let (p0, _) = self.dependent_parameters(q_v, q_h);
+        let (sin_p0, cos_p0) = self.p0_sin_cos(q_v, q_h);
         let a = Vector2::new(0.0, q_v);
         let d = Vector2::new(q_h, 0.0);
-        let u0 = Vector2::new(p0.cos(), p0.sin());
+        let u0 = Vector2::new(cos_p0, sin_p0);
         let b = a + u0 * self.c;
         let c = a + u0 * self.l0;
         let e = c + (d - b);
@@ -98,10 +107,8 @@ impl DependentFunction for PantographGeometry {
         };
         let p0 = u0.acos().minus(&w.asin());
         let p1 = u1.acos();
-        let root = |u: f64| (1.0 - u * u).sqrt();
-        let (sin_a, cos_b) = (root(u0.value), root(w.value));
-        let sin_cos_p0 = (sin_a * cos_b - u0.value * w.value, u0.value * cos_b + sin_a * w.value);
-        let sin_cos_p1 = (root(u1.value), u1.value);
+        let sin_cos_p0 = p0_sin_cos(u0.value, w.value);
+        let sin_cos_p1 = ((1.0 - u1.value * u1.value).sqrt(), u1.value);
         for (o, (p, sin_cos)) in out.iter_mut().zip([(p0, sin_cos_p0), (p1, sin_cos_p1)]) {
             o.value = p.value;
             o.rate = p.rate;
@@ -111,6 +118,14 @@ impl DependentFunction for PantographGeometry {
         }
         true
     }
+}
+
+/// (sin p0, cos p0) for p0 = a − b with a = acos(u0), b = asin(w) (Eq. 3.62: u0 = cos δ,
+/// w = q_v / k = sin γ): sin p0 = sin a cos b − cos a sin b, cos p0 = cos a cos b + sin a sin b,
+/// sin a = √(1 − u0²), cos b = √(1 − w²).
+fn p0_sin_cos(u0: f64, w: f64) -> (f64, f64) {
+    let (sin_a, cos_b) = ((1.0 - u0 * u0).sqrt(), (1.0 - w * w).sqrt());
+    (sin_a * cos_b - u0 * w, u0 * cos_b + sin_a * w)
 }
 
 /// A scalar function of (q_v, q_h) with its gradient, its rate along (q̇_v, q̇_h) and the

@@ -42,9 +42,18 @@ impl AnalogLowPass {
     /// with h = t − t_0, s = (x − x_0)/h and a = exp(−ω_c h), the exact solution is
     /// y = x − s/ω_c + (y_0 − x_0 + s/ω_c) a. With h = 0 the input jumps to `x`.
     pub fn advance(&mut self, t: f64, x: f64) {
+        self.advance_decaying(t, x, self.decay(t));
+    }
+
+    /// a = exp(−ω_c h) over h = t − t_0.
+    fn decay(&self, t: f64) -> f64 {
+        (-self.omega_c * (t - self.t)).exp()
+    }
+
+    /// [`Self::advance`] with a = [`Self::decay`] given (filters of the same ω_c and t_0 share it).
+    fn advance_decaying(&mut self, t: f64, x: f64, a: f64) {
         let h = t - self.t;
         if h > 0.0 {
-            let a = (-self.omega_c * h).exp();
             let lag = (x - self.x) / (h * self.omega_c);
             self.y = x - lag + (self.y - self.x + lag) * a;
             self.t = t;
@@ -101,8 +110,13 @@ impl<const N: usize> CurrentSensors<N> {
     /// The motor currents `i` at `t` (an accepted integration step, or the start of a control
     /// period after the voltages jumped).
     pub fn advance(&mut self, t: f64, i: &[f64; N]) {
+        // The filters share ω_c and their last instant (they are built and advanced together):
+        // one exponential for all.
+        let Some(&first) = self.filters.first() else { return };
+        let a = first.decay(t);
         for (f, &x) in self.filters.iter_mut().zip(i) {
-            f.advance(t, x);
+            debug_assert!(f.omega_c == first.omega_c && f.t == first.t);
+            f.advance_decaying(t, x, a);
         }
     }
 

@@ -74,23 +74,16 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     rec.begin_row();
     rec.put(meas.t, || (s("t"), "s", s("control instant")));
     const BODY: [(&str, &str, &str); 6] = [("X", "m", "body centre x"), ("Y", "m", "body centre y"), ("Z", "m", "body centre height"), ("yaw", "rad", "body yaw"), ("pitch", "rad", "body pitch"), ("roll", "rad", "body roll")];
-    for (i, (n, u, d)) in BODY.iter().enumerate() {
-        rec.put(q[i], || (s(n), u, s(d)));
-    }
+    rec.put_each(&q[..6], |i| (s(BODY[i].0), BODY[i].1, s(BODY[i].2)));
     const BODY_DOT: [(&str, &str); 6] = [("X_dot", "m/s"), ("Y_dot", "m/s"), ("Z_dot", "m/s"), ("yaw_dot", "rad/s"), ("pitch_dot", "rad/s"), ("roll_dot", "rad/s")];
-    for (i, (n, u)) in BODY_DOT.iter().enumerate() {
-        rec.put(qd[i], || (s(n), u, format!("time derivative of {}", &n[..n.len() - 4])));
-    }
-    for k in 0..JOINTS {
-        rec.put(q[6 + k], || (joint_name("", k, ""), joint_unit(k, ("rad", "m")), format!("joint position, leg {}", k / 3)));
-    }
-    for k in 0..JOINTS {
-        rec.put(qd[6 + k], || (joint_name("", k, "_dot"), joint_unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
-    }
+    rec.put_each(&qd[..6], |i| {
+        let (n, u) = BODY_DOT[i];
+        (s(n), u, format!("time derivative of {}", &n[..n.len() - 4]))
+    });
+    rec.put_each(&q[6..6 + JOINTS], |k| (joint_name("", k, ""), joint_unit(k, ("rad", "m")), format!("joint position, leg {}", k / 3)));
+    rec.put_each(&qd[6..6 + JOINTS], |k| (joint_name("", k, "_dot"), joint_unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
     if groups.references {
-        for k in 0..JOINTS {
-            rec.put(cmd.references[k], || (joint_name("", k, "_ref"), joint_unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
-        }
+        rec.put_each(&cmd.references, |k| (joint_name("", k, "_ref"), joint_unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
     }
     if let Some(g) = gait {
         record_gait(rec, g);
@@ -98,25 +91,13 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     if let Some(g) = ground {
         record_ground_detection(rec, g);
     }
-    for k in 0..JOINTS {
-        rec.put(out.voltage[k], || (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
-    }
-    for k in 0..JOINTS {
-        rec.put(out.current[k], || (joint_name("i_", k, ""), "A", s("motor current")));
-    }
-    for k in 0..JOINTS {
-        rec.put(meas.currents[k], || (joint_name("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
-    }
-    for k in 0..JOINTS {
-        rec.put(out.motor_torque[k], || (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
-    }
-    for k in 0..JOINTS {
-        rec.put(out.friction_torque[k], || (joint_name("tau_f_", k, ""), joint_unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
-    }
+    rec.put_each(&out.voltage, |k| (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
+    rec.put_each(&out.current, |k| (joint_name("i_", k, ""), "A", s("motor current")));
+    rec.put_each(&meas.currents, |k| (joint_name("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
+    rec.put_each(&out.motor_torque, |k| (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
+    rec.put_each(&out.friction_torque, |k| (joint_name("tau_f_", k, ""), joint_unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
     if groups.bristles {
-        for k in 0..JOINTS {
-            rec.put(out.bristle[k], || (joint_name("z_", k, ""), joint_unit(k, ("rad", "m")), s("LuGre bristle deflection")));
-        }
+        rec.put_each(&out.bristle, |k| (joint_name("z_", k, ""), joint_unit(k, ("rad", "m")), s("LuGre bristle deflection")));
     }
     for (f, c) in out.contact.iter().enumerate() {
         rec.put(c.force.x, || (format!("Fx[{f}]"), "N", s("ground force on the foot, x (global)")));
@@ -130,15 +111,9 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
         rec.put(x.y, || (format!("foot_y[{f}]"), "m", s("foot position y (global)")));
         rec.put(x.z, || (format!("foot_z[{f}]"), "m", s("foot position z (global)")));
     }
-    for k in 0..JOINTS {
-        rec.put(e.electrical[k], || (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy drawn, integral of u i")));
-    }
-    for k in 0..JOINTS {
-        rec.put(e.joule[k], || (joint_name("E_joule_", k, ""), "J", s("cumulative Joule losses in motor and H-bridge")));
-    }
-    for k in 0..JOINTS {
-        rec.put(e.friction_work[k], || (joint_name("E_fric_", k, ""), "J", s("cumulative work against joint friction, integral of tau_f q'")));
-    }
+    rec.put_each(&e.electrical, |k| (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy drawn, integral of u i")));
+    rec.put_each(&e.joule, |k| (joint_name("E_joule_", k, ""), "J", s("cumulative Joule losses in motor and H-bridge")));
+    rec.put_each(&e.friction_work, |k| (joint_name("E_fric_", k, ""), "J", s("cumulative work against joint friction, integral of tau_f q'")));
     rec.put(e.kinetic, || (s("E_kin"), "J", s("kinetic energy")));
     rec.put(e.potential, || (s("E_pot"), "J", s("gravitational potential energy")));
     rec.put(e.contact_work.iter().sum(), || (s("E_contact"), "J", s("cumulative work of the feet on the ground")));

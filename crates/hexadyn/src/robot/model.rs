@@ -23,7 +23,7 @@ use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
-use crate::sim::{Jacobian, Layout, Order, System};
+use crate::sim::{zero_matrix, Jacobian, Layout, Order, System};
 
 mod surrogate;
 use surrogate::Surrogate;
@@ -408,9 +408,9 @@ impl Robot {
         let contact = self.outputs.contact.map(|c| c.force);
         let joint: [f64; JOINTS] = std::array::from_fn(|k| self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
         let scales = self.model.layout.scales.clone();
-        let mut mass = DMatrix::zeros(DOF, DOF);
+        let mut mass = zero_matrix(DOF, DOF);
         mbs::mass_matrix(&self.model.mechanics.model, &self.data, &mut mass);
-        let mut jac = InertialJacobian { q: q.to_vec(), kt: DMatrix::zeros(DOF, DOF), ct: DMatrix::zeros(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6], mass };
+        let mut jac = InertialJacobian { q: q.to_vec(), kt: zero_matrix(DOF, DOF), ct: zero_matrix(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6], mass };
         let (mut f0, mut fp) = (vec![0.0; DOF], vec![0.0; DOF]);
         let (mut v0, mut vp) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
         self.frozen_residual(q, qd, qdd, &contact, &joint, &mut f0, &mut v0);

@@ -137,6 +137,20 @@ impl Recorder {
         self.cursor += 1;
     }
 
+    /// Puts `values` as the next values of the row, `spec(k)` defining the column of `values[k]`
+    /// on the first row: after it one copy of the slice instead of a [`Self::put`] per value.
+    pub fn put_each(&mut self, values: &[f64], spec: impl Fn(usize) -> (String, &'static str, String)) {
+        if self.rows == 0 {
+            for (k, &value) in values.iter().enumerate() {
+                self.put(value, || spec(k));
+            }
+            return;
+        }
+        let kept = self.columns.len().saturating_sub(self.cursor).min(values.len());
+        self.values.extend_from_slice(&values[..kept]);
+        self.cursor += values.len();
+    }
+
     /// Closes the row.
     ///
     /// # Panics

@@ -12,9 +12,16 @@ pub struct Jacobian {
     pub kt: DMatrix<f64>,
 }
 
+/// A rows × cols matrix of zeros from a zeroed allocation: nalgebra's `DMatrix::zeros` writes
+/// the entries one by one (about 8 instructions each, 14 k for the three 42 × 42 blocks of a
+/// Jacobian).
+pub(crate) fn zero_matrix(rows: usize, cols: usize) -> DMatrix<f64> {
+    DMatrix::from_vec(rows, cols, vec![0.0; rows * cols])
+}
+
 impl Jacobian {
     pub fn zeros(n: usize) -> Self {
-        Jacobian { m: DMatrix::zeros(n, n), ct: DMatrix::zeros(n, n), kt: DMatrix::zeros(n, n) }
+        Jacobian { m: zero_matrix(n, n), ct: zero_matrix(n, n), kt: zero_matrix(n, n) }
     }
     pub fn fill_zero(&mut self) {
         self.m.fill(0.0);
@@ -24,7 +31,11 @@ impl Jacobian {
     /// The Newmark iteration matrix J = M + γh CT + βh² KT (Eq. 3.14).
     pub fn iteration_matrix(&self, beta: f64, gamma: f64, h: f64) -> DMatrix<f64> {
         let (g, b) = (gamma * h, beta * h * h);
-        DMatrix::from_fn(self.m.nrows(), self.m.ncols(), |i, j| self.m[(i, j)] + self.ct[(i, j)] * g + self.kt[(i, j)] * b)
+        let mut j = self.m.clone();
+        for ((x, c), k) in j.as_mut_slice().iter_mut().zip(self.ct.as_slice()).zip(self.kt.as_slice()) {
+            *x += c * g + k * b;
+        }
+        j
     }
     /// Exact blocks when the system provides them, finite differences otherwise.
     pub fn evaluate<S: System + ?Sized>(sys: &mut S, t: f64, q: &[f64], qd: &[f64], qdd: &[f64]) -> Self {

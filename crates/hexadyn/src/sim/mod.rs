@@ -15,6 +15,7 @@ mod system;
 
 pub use error::{ResidualRow, SimError};
 pub use jacobian::{finite_difference_jacobian, finite_difference_jacobian_with_steps, Jacobian};
+pub(crate) use jacobian::zero_matrix;
 pub use linearize::{linearize, Linearization, Pole};
 pub use newmark::{Newmark, NewmarkOptions, NewmarkStats, State};
 pub use statics::{static_equilibrium, StaticOptions};
