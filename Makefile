@@ -17,11 +17,12 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup chromium run test test-rust test-python bench bench-peer bench-montecarlo terrains lock clean
+.PHONY: help setup chromium run test lint test-rust test-python bench bench-peer bench-montecarlo terrains lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
-	@echo "make test   set everything up, then run the Rust and Python tests"
+	@echo "make test   set everything up, then run clippy and the Rust and Python tests"
+	@echo "make lint   clippy on every crate and target, warnings as errors"
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
 	@echo "make bench-peer  the 75 s walk in hexadyn and in MuJoCo, timed in the same run"
@@ -55,7 +56,13 @@ $(BUILD_STAMP): $(DEPS_STAMP) $(RUST_SOURCES)
 run: setup
 	$(VENV)/bin/hexadyn simulate
 
-test: setup chromium test-rust test-python
+test: setup chromium lint test-rust test-python
+
+# Clippy with the workspace's lint settings (Cargo.toml [workspace.lints]); rustup adds the
+# component where it is missing.
+lint:
+	@$(CARGO) clippy --version >/dev/null 2>&1 || rustup component add clippy
+	$(CARGO) clippy --workspace --all-targets --quiet -- -D warnings
 
 test-rust:
 	$(CARGO) test --workspace --release --exclude hexadyn-py

@@ -34,7 +34,7 @@ fn controller(d: &RobotDescription, period: f64, vx: f64) -> (GaitController, [f
     let lift = 0.045;
     let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
     let joints = joints_at_workspace_centres(&legs, &workspaces, height).unwrap();
-    let pis = joint_pis(&d, d.controller.period_s);
+    let pis = joint_pis(d, d.controller.period_s);
     let options = GaitOptions { period, pattern: GaitPattern::tripod(), cycle: FootCycle::Enhanced { overlap: 0.05 }, aep: AepMode::Omnidirectional, lift, dt: d.controller.period_s };
     (GaitController::new(options, legs, workspaces, pis, Box::new(Constant(Heading::new(vx, 0.0, 0.0)))), joints)
 }

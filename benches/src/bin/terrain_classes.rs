@@ -115,8 +115,8 @@ fn main() {
     let only_class = value("--class");
     let classes: Vec<TerrainClass> = classes()
         .into_iter()
-        .filter(|c| only_kind.as_deref().map_or(true, |k| k == kind(c)))
-        .filter(|c| only_class.as_deref().map_or(true, |l| l == c.label()))
+        .filter(|c| only_kind.as_deref().is_none_or(|k| k == kind(c)))
+        .filter(|c| only_class.as_deref().is_none_or(|l| l == c.label()))
         .collect();
     assert!(!classes.is_empty(), "no class matches --kind {only_kind:?} --class {only_class:?} (labels such as \"step 8 cm\", \"slope 20 deg\", \"rough 2.0 cm RMS\")");
     let jobs: Vec<(usize, u64)> = (0..classes.len()).flat_map(|c| (0..seeds).map(move |s| (c, s))).collect();
@@ -128,14 +128,15 @@ fn main() {
     let started = Instant::now();
     std::thread::scope(|scope| {
         for _ in 0..workers {
-            scope.spawn(|| loop {
-                let Some(&(class, seed)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) else { break };
-                let start = Instant::now();
-                let (drawn, verdict, simulated_s) = run(&classes[class], seed);
-                let wall_s = start.elapsed().as_secs_f64();
-                let mut r = results.lock().expect("no worker panicked");
-                r.push(RunResult { class, seed, drawn, verdict, wall_s, simulated_s });
-                eprint!("\r{} / {} runs, {:.0} s", r.len(), jobs.len(), started.elapsed().as_secs_f64());
+            scope.spawn(|| {
+                while let Some(&(class, seed)) = jobs.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let start = Instant::now();
+                    let (drawn, verdict, simulated_s) = run(&classes[class], seed);
+                    let wall_s = start.elapsed().as_secs_f64();
+                    let mut r = results.lock().expect("no worker panicked");
+                    r.push(RunResult { class, seed, drawn, verdict, wall_s, simulated_s });
+                    eprint!("\r{} / {} runs, {:.0} s", r.len(), jobs.len(), started.elapsed().as_secs_f64());
+                }
             });
         }
     });

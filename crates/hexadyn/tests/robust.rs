@@ -134,7 +134,7 @@ fn input_files_are_bounded_regular_files() {
 fn a_byte_order_mark_is_accepted() {
     let text = format!("\u{feff}{}", with("stand_six_legs", "duration_s = 10.0", "duration_s = 0.05"));
     let s = parse(&text).unwrap();
-    assert_eq!(Scenario::model_flags(&s.text, "stored").unwrap().inductance, false);
+    assert!(!Scenario::model_flags(&s.text, "stored").unwrap().inductance);
 }
 
 /// The chunked run hands out exactly the rows of the whole run: the first row alone, then

@@ -209,7 +209,7 @@ mod tests {
             q[joint_index(leg, 1)] = 0.045 + 0.005 * leg as f64;
             q[joint_index(leg, 2)] = 0.01 + 0.008 * leg as f64;
         }
-        kinematics(&mech.model, &mut data, &q, &vec![0.0; DOF]);
+        kinematics(&mech.model, &mut data, &q, &[0.0; DOF]);
         let body = Htm { rotation: crate::spatial::yaw_pitch_roll(q[3], q[4], q[5]), translation: Vector3::new(q[0], q[1], q[2]) };
         for (leg, bodies) in mech.legs.iter().enumerate() {
             let (qr, qv, qh) = (q[joint_index(leg, 0)], q[joint_index(leg, 1)], q[joint_index(leg, 2)]);
@@ -231,7 +231,7 @@ mod tests {
             q[joint_index(leg, 1)] = 0.06;
             q[joint_index(leg, 2)] = 0.04;
         }
-        kinematics(&mech.model, &mut data, &q, &vec![0.0; DOF]);
+        kinematics(&mech.model, &mut data, &q, &[0.0; DOF]);
         let mut m = DMatrix::zeros(DOF, DOF);
         mass_matrix(&mech.model, &data, &mut m);
         let p = &mech.parameters;

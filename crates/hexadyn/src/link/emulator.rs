@@ -151,7 +151,7 @@ impl Emulator {
 
     /// Whether the emulator stopped by itself (idle timeout or failure).
     pub fn is_finished(&self) -> bool {
-        self.model.as_ref().map_or(true, JoinHandle::is_finished)
+        self.model.as_ref().is_none_or(JoinHandle::is_finished)
     }
 
     /// Stops the slaves and returns the report.

@@ -106,7 +106,7 @@ impl FaultInjector {
             self.counts.silenced += 1;
             return Vec::new();
         }
-        let may_destroy = f.max_consecutive.map_or(true, |n| self.destroyed[leg] < n);
+        let may_destroy = f.max_consecutive.is_none_or(|n| self.destroyed[leg] < n);
         let (lost, corrupt, resize) = (self.rng.random_bool(f.loss), self.rng.random_bool(f.corrupt), self.rng.random_bool(f.wrong_size));
         if !may_destroy || !(lost || corrupt || resize) {
             self.destroyed[leg] = 0;

@@ -385,6 +385,7 @@ impl Robot {
 
     /// Multibody rows with the contact and joint forces frozen at `contact` and `joint`
     /// (generalized joint forces), and the foot velocities.
+    #[allow(clippy::too_many_arguments)] // the state (q, q', q''), the two frozen forces, two outputs
     fn frozen_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], contact: &[Vector3<f64>; 6], joint: &[f64; JOINTS], f: &mut [f64], feet: &mut [Vector3<f64>; 6]) {
         self.kinematics(q, qd);
         let mech = &self.model.mechanics;

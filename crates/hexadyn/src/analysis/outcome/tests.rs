@@ -23,7 +23,7 @@ fn walk(duration: f64, edit: impl Fn(f64, &mut [f64; 14])) -> TimeSeries {
     for k in 0..rows {
         let t = k as f64 * DT;
         // A tripod: feet 0, 3, 4 then 1, 2, 5 swing, every other 5 s; three always loaded.
-        let swinging = |f: usize| ((t / 5.0) as usize % 2 == 0) == [0, 3, 4].contains(&f);
+        let swinging = |f: usize| ((t / 5.0) as usize).is_multiple_of(2) == [0, 3, 4].contains(&f);
         let mut row = [t, 0.01 * t, 0.0, STANDING_Z, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         for f in 0..6 {
             row[8 + f] = if swinging(f) { 0.0 } else { 40.0 };

@@ -277,12 +277,11 @@ pub(super) fn centre_velocity(kin: &LegKinematics, c_leg: &Vector3<f64>, frame: 
 impl Controller for GaitController {
     fn update(&mut self, m: &Measurements) -> Command {
         let h = self.heading.heading(m.t);
-        if self.walk.body.is_none() {
-            self.start(m);
-        } else {
+        if let Some(body) = &mut self.walk.body {
             // Eq. 7.12-7.23: the desired body HTM from the heading velocities.
-            let dt = self.options.dt;
-            self.walk.body.as_mut().expect("started").step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), dt);
+            body.step(h.velocity, Vector3::new(0.0, 0.0, h.yaw_rate), self.options.dt);
+        } else {
+            self.start(m);
         }
         self.try_switch(m.t);
         let body = self.walk.body.clone().expect("started");

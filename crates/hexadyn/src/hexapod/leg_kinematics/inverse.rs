@@ -9,9 +9,6 @@
 //! linkage can reach the target with the ranges ignored, how far beyond the ranges that
 //! would be. The joints returned are always finite and within the ranges.
 
-// `!(a < b)` is used on purpose: it is also true when a comparison involves a NaN.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::Vector3;
 
 use super::{LegKinematics, LegKinematicsError, RzMinus};

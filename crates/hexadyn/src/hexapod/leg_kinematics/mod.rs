@@ -42,9 +42,6 @@
 //! range, the annular sector [max ρ_lo, min ρ_hi] × q_r range; its centre lies on the
 //! bisector of the sector.
 
-// `!(a < b)` is used on purpose: it is also true when a comparison involves a NaN.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::mechanics::MechanicsParameters;

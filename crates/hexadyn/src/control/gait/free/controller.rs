@@ -15,7 +15,7 @@ use nalgebra::{Vector2, Vector3};
 use super::elevator::{resistance, retreat, ELEVATOR_FORCE};
 use super::landing::SETTLING_TIME_CONSTANTS;
 use super::landing::LandingDetector;
-use super::posture::{ground_plane, solve_posture, PostureCorrection};
+use super::posture::{ground_plane, solve_posture};
 use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};
 use super::velocity::corrected_velocities;
 use crate::control::gait::body_motion::{BodyMotion, Pose};
@@ -248,7 +248,7 @@ impl FreeGaitController {
             reference.push(kin.to_body(&self.workspaces[l].centre_at(-self.options.body_height)).z);
         }
         // The simplex does not fail on finite inputs; if it ever did, the posture is kept.
-        let c = solve_posture(&p0, &reference).unwrap_or(PostureCorrection::default());
+        let c = solve_posture(&p0, &reference).unwrap_or_default();
         let (vz, wx, wy) = c.velocities(self.options.posture_time);
         self.posture = (Vector3::new(vz, wx, wy), t + self.options.posture_time);
         self.state.postures += 1;
