@@ -38,7 +38,7 @@ from matplotlib.figure import Figure
 from hexadyn import atomic, energy, plots
 from hexadyn.report import write_csv
 from hexadyn.runner import resolve_scenario, simulate
-from hexadyn.vocabulary import JOINT_TYPES, LEGS
+from hexadyn.vocabulary import LEGS
 
 #: Friction models of the comparison: name -> scenario overrides (Section 6.1 and 6.4.4).
 MODELS: dict[str, dict[str, Any]] = {
@@ -235,11 +235,12 @@ def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: l
 
 
 def joint_tables(comparison: Comparison, velocity: float | None = None) -> dict[str, pd.DataFrame]:
-    """Tables 6.3-6.6: for each joint type, the averaged power (W) per leg (rows 0-5, total)
+    """Tables 6.3-6.6: for each joint of the robot, the averaged power (W) per leg (rows 0-5, total)
     and friction model (columns), at `velocity` (default: the comparison's table velocity)."""
     v = comparison.table_velocity if velocity is None else velocity
     at = comparison.power.xs(v, level="velocity_m_s")
-    return {j: at[j].unstack("model")[list(at.index.unique("model"))].rename_axis(index="leg", columns=None) for j in JOINT_TYPES}
+    joints = [j for j in at.columns if j != energy.TOTAL]
+    return {j: at[j].unstack("model")[list(at.index.unique("model"))].rename_axis(index="leg", columns=None) for j in joints}
 
 
 def figures(comparison: Comparison) -> dict[str, Figure]:

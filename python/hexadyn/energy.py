@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from hexadyn import _core
-from hexadyn.vocabulary import ACTUATORS, JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
+from hexadyn.vocabulary import LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -66,9 +66,9 @@ __all__ = [
 ]
 
 
-def _columns(quantity: str) -> list[str]:
+def _columns(results: Results, quantity: str) -> list[str]:
     """The columns of an actuator quantity for every actuator: ``E_el_q_r[0]``, ..."""
-    return [actuator_column(quantity, a) for a in ACTUATORS]
+    return [actuator_column(quantity, a) for a in results.joints.actuators]
 
 
 def _require(frame: pd.DataFrame, columns: Sequence[str], what: str) -> None:
@@ -97,11 +97,11 @@ def power(results: Results) -> pd.DataFrame:
     energy of each actuator.
     """
     ts = results.timeseries
-    columns = _columns("E_el")
+    columns = _columns(results, "E_el")
     _require(ts, columns, "the power")
     dt = _period(ts.index)
     p = np.diff(ts[columns].to_numpy(), axis=0) / dt
-    return pd.DataFrame(p, index=ts.index[1:], columns=list(ACTUATORS))
+    return pd.DataFrame(p, index=ts.index[1:], columns=list(results.joints.actuators))
 
 
 def sampled_power(results: Results) -> pd.DataFrame:
@@ -111,10 +111,10 @@ def sampled_power(results: Results) -> pd.DataFrame:
     period); Σ u_k i_k Δt approximates E_el to the variation of the current within a period.
     """
     ts = results.timeseries
-    _require(ts, _columns("u") + _columns("i"), "the sampled power")
-    u = ts[_columns("u")].to_numpy()
-    i = ts[_columns("i")].to_numpy()
-    return pd.DataFrame((u * i)[1:], index=ts.index[1:], columns=list(ACTUATORS))
+    _require(ts, _columns(results, "u") + _columns(results, "i"), "the sampled power")
+    u = ts[_columns(results, "u")].to_numpy()
+    i = ts[_columns(results, "i")].to_numpy()
+    return pd.DataFrame((u * i)[1:], index=ts.index[1:], columns=list(results.joints.actuators))
 
 
 def foot_phases(results: Results) -> pd.DataFrame | None:
@@ -142,6 +142,7 @@ def averaged_power(results: Results) -> pd.DataFrame:
     the mean power during the phase. ``table.loc["all"]`` is the layout of Tables 6.3-6.6.
     """
     p = power(results)
+    joints = results.joints.names
     dt = _period(results.timeseries.index)
     duration = dt * len(p)
     phases = foot_phases(results)
@@ -153,8 +154,8 @@ def averaged_power(results: Results) -> pd.DataFrame:
         rows = {}
         for leg in LEGS:
             mask = slice(None) if codes is None else phases[leg].isin(codes).to_numpy()
-            rows[leg] = [p[actuator(j, leg)].to_numpy()[mask].sum() * dt / duration for j in JOINT_TYPES]
-        block = pd.DataFrame.from_dict(rows, orient="index", columns=list(JOINT_TYPES))
+            rows[leg] = [p[actuator(j, leg)].to_numpy()[mask].sum() * dt / duration for j in joints]
+        block = pd.DataFrame.from_dict(rows, orient="index", columns=list(joints))
         block.loc[TOTAL] = block.sum()
         block[TOTAL] = block.sum(axis=1)
         blocks[name] = block
@@ -173,9 +174,9 @@ def _magnetic_energy_change(results: Results) -> np.ndarray:
     """Δ(½ L i²) per actuator (J), non-zero only if the scenario models the inductance
     (``[model] inductance = true``, Eq. 3.91)."""
     if not _models_inductance(results):
-        return np.zeros(len(ACTUATORS))
+        return np.zeros(len(results.joints.actuators))
     inductance = _robot_properties(results)["inductance_h"]
-    i = results.endpoints()[_columns("i")].to_numpy()
+    i = results.endpoints()[_columns(results, "i")].to_numpy()
     return 0.5 * inductance * (i[-1] ** 2 - i[0] ** 2)
 
 
@@ -199,13 +200,14 @@ def energy_breakdown(results: Results) -> pd.DataFrame:
     """
     ends = results.endpoints()
     kinds = {"electrical_j": "E_el", "joule_j": "E_joule", "friction_j": "E_fric"}
-    _require(ends, [c for quantity in kinds.values() for c in _columns(quantity)], "the energy breakdown")
+    _require(ends, [c for quantity in kinds.values() for c in _columns(results, quantity)], "the energy breakdown")
     first, last = ends.iloc[0], ends.iloc[-1]
-    table = pd.DataFrame(index=pd.Index(ACTUATORS, name="actuator"))
-    table["leg"] = [leg for leg in LEGS for _ in JOINT_TYPES]
-    table["joint"] = list(JOINT_TYPES) * len(LEGS)
+    joints = results.joints
+    table = pd.DataFrame(index=pd.Index(joints.actuators, name="actuator"))
+    table["leg"] = [leg for leg in LEGS for _ in joints.names]
+    table["joint"] = list(joints.names) * len(LEGS)
     for key, quantity in kinds.items():
-        cols = _columns(quantity)
+        cols = _columns(results, quantity)
         table[key] = last[cols].to_numpy() - first[cols].to_numpy()
     table["magnetic_j"] = _magnetic_energy_change(results)
     table["mechanical_j"] = table["electrical_j"] - table["joule_j"] - table["friction_j"] - table["magnetic_j"]

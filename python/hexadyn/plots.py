@@ -35,7 +35,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from hexadyn import energy, ground_detection
-from hexadyn.vocabulary import FAILED, JOINT_TYPES, LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
+from hexadyn.vocabulary import FAILED, LANDING, REVOLUTE, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -79,8 +79,18 @@ ENERGY_COLOURS = {"joule_j": "#c0392b", "friction_j": "#7f8c8d", "mechanical_j":
 ENERGY_LABELS = {"joule_j": "Joule losses", "friction_j": "friction work", "mechanical_j": "mechanical work", "magnetic_j": "magnetic energy change"}
 
 #: Display scale and unit of joint positions per joint type: degrees and millimetres (Figs. 6.4-6.15).
-_POSITION = dict(zip(JOINT_TYPES, [(180.0 / np.pi, "deg"), (1e3, "mm"), (1e3, "mm")]))
-_JOINT_NAMES = dict(zip(JOINT_TYPES, ["rotational", "vertical", "horizontal"]))
+def _position_scale(kind: str) -> tuple[float, str]:
+    """Plot scale and unit of a joint position: degrees for a revolute joint, mm for a
+    prismatic one."""
+    return (180.0 / np.pi, "deg") if kind == REVOLUTE else (1e3, "mm")
+
+
+def _symbol(joint: str) -> str:
+    """A joint name as a label: ``q_r`` as the math symbol $q_r$, any other name as it is."""
+    head, _, tail = joint.partition("_")
+    if not (head.isalpha() and tail.isalnum()):
+        return joint
+    return f"${head}_{tail}$" if len(tail) == 1 else f"${head}_{{{tail}}}$"
 _LEG_RANGE = f"{LEGS[0]}..{LEGS[-1]}"
 
 __all__ = [
@@ -161,11 +171,10 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
     unpowered scenario) the error panel is left out.
     """
     _check_leg(leg)
-    if joint not in JOINT_TYPES:
-        raise ValueError(f"joint = {joint!r}; allowed: {', '.join(JOINT_TYPES)}")
+    kind = results.joints.kind(joint)
     ts = results.timeseries
     name = actuator(joint, leg)
-    scale, unit = _POSITION[joint]
+    scale, unit = _position_scale(kind)
     t = ts.index.to_numpy()
     reference = leg_column(f"{joint}_ref", leg)
     has_ref = reference in ts.columns
@@ -178,7 +187,7 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
         ax.plot(t, ts[name] * scale, color=SIMULATED, label="simulated")
         if has_ref:
             ax.plot(t, ts[reference] * scale, color=REFERENCE, linestyle="--", label="reference")
-        ax.set_ylabel(f"${joint}$ [{unit}]")
+        ax.set_ylabel(f"{_symbol(joint)} [{unit}]")
         handles, _ = ax.get_legend_handles_labels()
         if has_ref:
             ax = next(it)
@@ -197,7 +206,7 @@ def joint_figure(results: Results, leg: int, joint: str) -> Figure:
         ax.set_xlim(t[0], t[-1])
         shades = _shade_phases(axes, results, leg)
         axes[0].legend(handles=handles + shades, loc="lower left", bbox_to_anchor=(0, 1.02), ncol=6, frameon=False, borderaxespad=0)
-        fig.suptitle(f"{_title(results)}: leg {leg}, {_JOINT_NAMES[joint]} joint ${joint}$")
+        fig.suptitle(f"{_title(results)}: leg {leg}, {kind} joint {_symbol(joint)}")
     return fig
 
 
@@ -318,14 +327,17 @@ def energy_breakdown_figure(results: Results) -> Figure:
 
 
 def _per_actuator(block: pd.DataFrame) -> pd.Series:
-    """A (leg x joint type) block of :func:`energy.averaged_power` as one value per actuator."""
-    return pd.Series({actuator(j, leg): block.loc[leg, j] for leg in LEGS for j in JOINT_TYPES})
+    """A (leg x joint) block of :func:`energy.averaged_power` as one value per actuator."""
+    joints = [j for j in block.columns if j != energy.TOTAL]
+    return pd.Series({actuator(j, leg): block.loc[leg, j] for leg in LEGS for j in joints})
 
 
 def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], labels: Mapping[str, str]) -> np.ndarray:
-    """Bars of the 18 actuators grouped by leg, the columns of `parts` stacked (positive parts
-    upwards from zero, negative ones downwards); returns the bar positions."""
-    x = np.array([4 * leg + k for leg in LEGS for k in range(len(JOINT_TYPES))], dtype=float)
+    """Bars of the 18 actuators (the index of `parts`, leg by leg) grouped by leg, the columns of
+    `parts` stacked (positive parts upwards from zero, negative ones downwards); returns the bar
+    positions."""
+    per_leg = len(parts) // len(LEGS)
+    x = np.array([(per_leg + 1) * (i // per_leg) + i % per_leg for i in range(len(parts))], dtype=float)
     up = np.zeros(len(x))
     down = np.zeros(len(x))
     for column in parts.columns:
@@ -335,11 +347,11 @@ def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], 
         up += np.clip(v, 0, None)
         down += np.clip(v, None, 0)
     ax.axhline(0, color="black", linewidth=0.6)
-    ax.set_xticks(x, [j.replace("q_", "") for _ in LEGS for j in JOINT_TYPES])
+    ax.set_xticks(x, [a.partition("[")[0].removeprefix("q_") for a in parts.index])
     ax.tick_params(axis="x", length=0)
     ax.grid(axis="x", visible=False)
     groups = ax.secondary_xaxis(-0.09)
-    groups.set_xticks([4 * leg + 1 for leg in LEGS], [f"leg {leg}" for leg in LEGS])
+    groups.set_xticks([(per_leg + 1) * leg + (per_leg - 1) / 2 for leg in LEGS], [f"leg {leg}" for leg in LEGS])
     groups.tick_params(length=0)
     groups.spines["bottom"].set_visible(False)
     ax.legend(loc="lower left", bbox_to_anchor=(0, 1.02), ncol=5, frameon=False, borderaxespad=0)
@@ -375,7 +387,7 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
     ``averaged_power`` and ``energy_breakdown``."""
     for leg in legs:
         _check_leg(leg)
-    out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in JOINT_TYPES}
+    out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in results.joints.names}
     if energy.foot_phases(results) is not None:
         out["gait_diagram"] = gait_diagram(results)
     if "X_ref" in results.timeseries.columns:

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 from hexadyn._core import __version__
+from hexadyn.vocabulary import Joints
 
 if TYPE_CHECKING:  # pandas is imported when needed (keeps `import hexadyn` light)
     import pandas as pd
@@ -176,6 +177,12 @@ class Results:
         if self.path is None:
             raise ValueError("these results hold no time series (not in memory, no results folder)")
         return self.path / TIMESERIES_FILE
+
+    @property
+    def joints(self) -> Joints:
+        """The names and kinds of the robot's leg joints (:class:`hexadyn.vocabulary.Joints`),
+        read from the robot description stored with the results."""
+        return Joints.of(self)
 
     @property
     def descriptions(self) -> dict[str, str]:

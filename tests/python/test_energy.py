@@ -15,7 +15,7 @@ from hexadyn import Results, energy, report
 
 from conftest import shortened
 
-ACTUATORS = [f"{j}[{leg}]" for leg in range(6) for j in ("q_r", "q_v", "q_h")]
+ACTUATORS = [f"{j}[{leg}]" for leg in range(6) for j in ("q_r", "q_v", "q_h")]  # AMRU5's joints
 
 
 def test_power_integrates_to_the_electrical_energy(walk: Results):

@@ -3,7 +3,7 @@
 //! identification removes the gravity contribution with it (Section 5.2.1).
 
 use hexadyn::description::{RobotDescription, AMRU5_TOML};
-use hexadyn::hexapod::{leg_joint_torques, Joint, Mechanics, MechanicsParameters, LEG_COUNT};
+use hexadyn::hexapod::{leg_joint_torques, PantographJoint, Mechanics, MechanicsParameters, LEG_COUNT};
 use hexadyn::mbs::Data;
 use nalgebra::Vector3;
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -37,7 +37,8 @@ impl PyLegModel {
         })
     }
 
-    /// The constants of `joint` ("q_r", "q_v" or "q_h") the identification needs, and the
+    /// The constants of `joint` (one of the robot's joint names, "q_r", "q_v" or "q_h" on
+    /// AMRU5) the identification needs, and the
     /// friction of `leg` as the simulation uses it (after the Section 6.1 rules), SI joint
     /// units: `torque_per_ampere` (n k_t, Eq. 5.17), `encoder_resolution` (rad or m per
     /// count), `resistance` (coil and H-bridge, Ω), `tau_f_d_plus`, `tau_f_d_minus`, `f_v_plus`, `f_v_minus`, `tau_f_s_plus`,
@@ -49,15 +50,12 @@ impl PyLegModel {
                 LEG_COUNT - 1
             )));
         }
-        let j = Joint::ALL
-            .into_iter()
-            .find(|j| j.symbol() == joint)
-            .ok_or_else(|| {
-                PyValueError::new_err(format!(
-                    "joint = {joint:?}: allowed \"q_r\", \"q_v\", \"q_h\""
-                ))
-            })?;
         let d = &self.description;
+        let names = &d.joints.names;
+        let j = names.position(joint).map(|j| PantographJoint::ALL[j]).ok_or_else(|| {
+            let allowed: Vec<String> = names.names().map(|n| format!("{n:?}")).collect();
+            PyValueError::new_err(format!("joint = {joint:?}: allowed {}", allowed.join(", ")))
+        })?;
         let f = d.friction(leg, j);
         let out = PyDict::new(py);
         out.set_item("torque_per_ampere", d.joint_torque_per_ampere(j))?;

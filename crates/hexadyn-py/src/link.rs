@@ -11,7 +11,6 @@ use hexadyn::link::faults::Faults;
 use hexadyn::link::protocol::{Duty, MotorCommands, SlaveReply};
 use hexadyn::link::run::spawn_robot_run;
 use hexadyn::link::LinkConfig;
-use hexadyn::scenario::SummaryValue;
 use numpy::PyArray1;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -59,18 +58,6 @@ pub fn decode_reply(data: &[u8]) -> PyResult<(u8, u16, [i32; 3], [i16; 3], u8)> 
     Ok((r.leg, r.seq, r.counts, r.currents_ma, r.supply))
 }
 
-fn summary_dict<'py>(py: Python<'py>, entries: Vec<(&'static str, SummaryValue)>) -> PyResult<Bound<'py, PyDict>> {
-    let summary = PyDict::new(py);
-    for (name, value) in entries {
-        match value {
-            SummaryValue::Text(s) => summary.set_item(name, s)?,
-            SummaryValue::Count(n) => summary.set_item(name, n)?,
-            SummaryValue::Number(x) => summary.set_item(name, x)?,
-        }
-    }
-    Ok(summary)
-}
-
 /// Runs the scenario's controller on the robot through the link configured in `link` and
 /// returns the dict of `run_scenario` ("columns", "units", "descriptions", "summary",
 /// "scenario", "robot", "robot_source") plus "events" (the dropped packets and missed periods
@@ -113,7 +100,7 @@ pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progres
     d.set_item("columns", columns)?;
     d.set_item("units", units)?;
     d.set_item("descriptions", descriptions)?;
-    d.set_item("summary", summary_dict(py, run.summary)?)?;
+    d.set_item("summary", crate::scenario::entries_dict(py, run.summary)?)?;
     d.set_item("scenario", text)?;
     d.set_item("robot", robot)?;
     d.set_item("robot_source", robot_source)?;

@@ -4,7 +4,7 @@
 
 use hexadyn::scenario::DEFAULT_ROBOT;
 use hexadyn::description::{Gaussian, RobotDescription};
-use hexadyn::hexapod::Joint;
+use hexadyn::hexapod::PantographJoint;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -22,7 +22,7 @@ fn physical_bounds(parameter: &str) -> (f64, f64) {
     }
 }
 
-fn field(joint: Joint, parameter: &str) -> String {
+fn field(joint: PantographJoint, parameter: &str) -> String {
     format!("model.joint_friction.{}.{parameter}", joint.symbol())
 }
 
@@ -60,7 +60,7 @@ pub fn monte_carlo_distributions<'py>(py: Python<'py>, robot: &str) -> PyResult<
         gaussians.set_item(&name, (g.mu, g.sigma))?;
         bounds.set_item(&name, physical_bounds(parameter))
     };
-    for joint in Joint::ALL {
+    for joint in PantographJoint::ALL {
         let (dry_plus, viscous_plus, dry_minus, viscous_minus) = description.monte_carlo_distribution(joint);
         for (parameter, g) in [("tau_f_d_plus", Some(dry_plus)), ("f_v_plus", viscous_plus), ("tau_f_d_minus", Some(dry_minus)), ("f_v_minus", viscous_minus)] {
             match g {
@@ -73,7 +73,7 @@ pub fn monte_carlo_distributions<'py>(py: Python<'py>, robot: &str) -> PyResult<
     let mut load_parameters = Vec::new();
     for (parameter, g) in [("a_2_plus", load.a_2_plus), ("a_1_plus", load.a_1_plus), ("a_2_minus", load.a_2_minus), ("a_1_minus", load.a_1_minus)] {
         if let Some(g) = g {
-            let name = field(Joint::Horizontal, parameter);
+            let name = field(PantographJoint::Horizontal, parameter);
             draw(name.clone(), g, parameter)?;
             load_parameters.push(name);
         }

@@ -7,6 +7,8 @@ use std::time::{Duration, Instant};
 
 use std::sync::Mutex;
 
+use std::borrow::Cow;
+
 use hexadyn::robot::recorder::TimeSeries;
 use hexadyn::scenario::{run_scenario_chunked, run_scenario_until, HeadingSpec, ModelFlags, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
 use hexadyn::physics::Extent;
@@ -244,8 +246,14 @@ fn columns_dict(py: Python<'_>, series: TimeSeries) -> PyResult<Bound<'_, PyDict
 }
 
 fn summary_dict<'py>(py: Python<'py>, summary: &Summary) -> PyResult<Bound<'py, PyDict>> {
+    entries_dict(py, summary.entries())
+}
+
+/// The summary entries of a run (a simulation's or the robot link's) as a dict.
+pub(crate) fn entries_dict<'py>(py: Python<'py>, entries: Vec<(Cow<'static, str>, SummaryValue)>) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    for (name, value) in summary.entries() {
+    for (name, value) in entries {
+        let name = name.as_ref();
         match value {
             SummaryValue::Text(s) => d.set_item(name, s)?,
             SummaryValue::Count(n) => d.set_item(name, n)?,

@@ -1,23 +1,21 @@
-//! The engine's schema for the Python front end, so that Python never restates it: the joint
-//! names and the number of legs of the column names, the foot phase codes of the `phase[l]`
+//! The engine's schema for the Python front end, so that Python never restates it: the number
+//! of legs of the column names, a robot's joint names and kinds (`robot_properties`), the foot phase codes of the `phase[l]`
 //! columns, the robot's mass and motor inductance as the engine reads its description, and the
 //! specific resistance of Eq. 6.6.
 
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::control::gait::schedule::FAILED_LEG_CODE;
 use hexadyn::description::RobotDescription;
-use hexadyn::hexapod::{Joint, LEG_COUNT};
+use hexadyn::hexapod::LEG_COUNT;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-/// Adds `JOINT_NAMES` (the joint symbols in the thesis order, `("q_r", "q_v", "q_h")`),
-/// `LEG_COUNT` (6) and `PHASE_CODES` (foot phase name -> code of the `phase[l]` columns:
+/// Adds `LEG_COUNT` (6) and `PHASE_CODES` (foot phase name -> code of the `phase[l]` columns:
 /// support 0, takeoff 1, swing 2, landing 3, and 4 for a failed leg held up by the free gait)
 /// and the functions of this module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
-    m.add("JOINT_NAMES", PyTuple::new(py, Joint::ALL.map(Joint::symbol))?)?;
     m.add("LEG_COUNT", LEG_COUNT)?;
     let phases = PyDict::new(py);
     for phase in FootPhase::ALL {
@@ -37,7 +35,10 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 ///   summary's `robot_mass_kg`;
 /// - "stated_mass_kg": `inertia.total_mass_kg`, the total mass as printed in Table B.2
 ///   ("about 34 kg", checked against m_0 + 6 m_leg within 5 %);
-/// - "inductance_h": the motor inductance L (H) of Eq. 3.91.
+/// - "inductance_h": the motor inductance L (H) of Eq. 3.91;
+/// - "joints": the names and kinds of a leg's three joints in the order of q, a tuple of
+///   `(name, kind)` pairs, kind `"revolute"` or `"prismatic"` (AMRU5: `("q_r", "revolute")`,
+///   `("q_v", "prismatic")`, `("q_h", "prismatic")`): the names of the results columns.
 ///
 /// Raises ValueError (one line naming `origin` and the field) for an invalid description.
 #[pyfunction]
@@ -48,6 +49,8 @@ pub fn robot_properties<'py>(py: Python<'py>, text: &str, origin: &str) -> PyRes
     d.set_item("mass_kg", robot.total_mass_kg())?;
     d.set_item("stated_mass_kg", robot.inertia.total_mass_kg)?;
     d.set_item("inductance_h", robot.motor.inductance_h())?;
+    let joints = &robot.joints.names;
+    d.set_item("joints", PyTuple::new(py, (0..3).map(|j| (joints.name(j), joints.kind(j).name())))?)?;
     Ok(d)
 }
 

@@ -15,7 +15,7 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use hexadyn::control::Encoder;
-use hexadyn::hexapod::{Joint, JOINTS};
+use hexadyn::hexapod::{PantographJoint, JOINTS};
 use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
 use hexadyn::link::faults::Faults;
 use hexadyn::link::run::{run_robot, RobotRun};
@@ -57,7 +57,7 @@ fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRu
 /// emulator latched for that sequence number: no corrupted, stale or foreign packet reached
 /// the controller.
 fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) {
-    let encoders: [Encoder; JOINTS] = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: s.robot.reduction(Joint::ALL[k % 3]) });
+    let encoders: [Encoder; JOINTS] = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: s.robot.reduction(PantographJoint::ALL[k % 3]) });
     let periods = run.series.values("period").expect("period column");
     for (row, &p) in periods.iter().enumerate() {
         if run.series.values("last_reply").expect("last_reply")[row].is_nan() {
@@ -65,7 +65,7 @@ fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) 
         }
         let latched = report.history.iter().find(|h| u64::from(h.seq) == p as u64).unwrap_or_else(|| panic!("period {p} was never applied by the emulator"));
         for (k, enc) in encoders.iter().enumerate() {
-            let name = format!("{}[{}]", Joint::ALL[k % 3].symbol(), k / 3);
+            let name = format!("{}[{}]", PantographJoint::ALL[k % 3].symbol(), k / 3);
             let seen = run.series.values(&name).expect("position column")[row];
             assert_eq!(seen, f64::from(latched.counts[k]) * enc.resolution(), "row {row} (period {p}), {name}");
         }

@@ -3,7 +3,7 @@
 
 mod robot {
     use hexadyn::description::{DescriptionError, RobotDescription, AMRU5_TOML};
-    use hexadyn::hexapod::Joint;
+    use hexadyn::hexapod::PantographJoint;
     use std::path::PathBuf;
 
     fn shipped_path() -> PathBuf {
@@ -71,14 +71,14 @@ mod robot {
         assert_eq!(r.controller.q_h.k_v_per_m, 16854.0);
         assert_eq!(r.controller.period_s, 0.01);
         // Table 5.3-5.5 through the SI accessor
-        let f = r.friction(2, Joint::Horizontal);
+        let f = r.friction(2, PantographJoint::Horizontal);
         assert_eq!((f.tau_f_d_plus, f.tau_f_d_minus, f.f_v_minus), (329.1, -481.0, 0.0));
         assert_eq!(f.f_v_minus_measured, -4556.3);
         assert_eq!(f.load_dependence.unwrap().a_2_plus, 6.84);
-        let f = r.friction(4, Joint::Vertical);
+        let f = r.friction(4, PantographJoint::Vertical);
         assert_eq!((f.tau_f_s_plus, f.tau_f_s_minus), (457.2, -690.7));
         // Table 6.7 with the 3.56 fix
-        let (_, _, minus, _) = r.monte_carlo_distribution(Joint::Rotation);
+        let (_, _, minus, _) = r.monte_carlo_distribution(PantographJoint::Rotation);
         assert_eq!((minus.mu, minus.sigma), (-8.97, 3.56));
     }
 

@@ -10,7 +10,7 @@ use hexadyn::robot::model::FrictionModel;
 use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
 use hexadyn::sim::NewmarkOptions;
 use hexadyn::description::AMRU5_TOML;
-use hexadyn::hexapod::Joint;
+use hexadyn::hexapod::PantographJoint;
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios")
@@ -67,12 +67,12 @@ fn shipped_scenarios_are_valid() {
     let s = Scenario::from_file(scenarios_dir().join("leg_ramp.toml")).unwrap();
     assert_eq!(s.control, ControlMode::Pi);
     assert_eq!(s.motions.len(), 1);
-    assert_eq!((s.motions[0].leg, s.motions[0].joint), (1, Joint::Vertical));
+    assert_eq!((s.motions[0].leg, s.motions[0].joint), (1, PantographJoint::Vertical as usize));
     assert_eq!(s.initial.lifted_legs, vec![1, 2, 5]);
     assert_eq!(s.model.supply_voltage, 15.0);
     // 0.8 x the no-load speed (Section 4.4.3).
     let d = &s.robot;
-    let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(Joint::Vertical);
+    let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(PantographJoint::Vertical);
     match s.motions[0].motion {
         hexadyn::control::JointMotion::Ramp { rate: r, .. } => assert!((r - rate).abs() < 1e-6 * rate, "{r} vs {rate}"),
         m => panic!("{m:?}"),
@@ -341,7 +341,8 @@ fn runs_are_deterministic_and_recorded_with_units() {
     // accepted on the surrogate (sessions 32-33); the account itself closes to 0.1 % when the
     // integration converges (`walking_energy_account_closes_when_the_integration_converges`).
     assert!(sm.energy_electrical_j > 0.0 && sm.energy_balance_error_relative.abs() < 0.02, "{sm:?}");
-    let names: Vec<&str> = sm.entries().iter().map(|(n, _)| *n).collect();
+    let entries = sm.entries();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_ref()).collect();
     for n in ["duration_s", "wall_time_s", "integration_steps", "energy_electrical_j", "energy_balance_error_j", "body_height_change_m", "max_tracking_error_q_v_m"] {
         assert!(names.contains(&n), "{n} missing from the summary");
     }
@@ -566,7 +567,7 @@ fn summary_only_runs_sum_up_the_same_run() {
     let penetration = (0..6).flat_map(|f| full.series.values(&format!("penetration[{f}]")).unwrap().to_vec()).fold(f64::NEG_INFINITY, f64::max);
     assert_eq!(full.summary.max_penetration_m, penetration);
     assert!(penetration > 0.0, "the feet are in the ground");
-    for ((name, a), (_, b)) in full.summary.entries().into_iter().zip(bare.summary.entries()).filter(|((name, _), _)| *name != "wall_time_s") {
+    for ((name, a), (_, b)) in full.summary.entries().into_iter().zip(bare.summary.entries()).filter(|((name, _), _)| name != "wall_time_s") {
         let same = match (&a, &b) {
             (SummaryValue::Number(x), SummaryValue::Number(y)) => x.to_bits() == y.to_bits(),
             _ => a == b,
@@ -639,7 +640,8 @@ fn gait_runs_record_the_walk_deterministically() {
     assert!((g.distance_walked_m - g.reference_distance_m).abs() < 3e-3, "{g:?}");
     assert_eq!((g.clamped_ik_references, g.gait_switches, g.min_feet_on_ground), (0, 0, 3));
     assert!(g.max_foot_reference_outside_workspace_m < 1e-6, "{g:?}");
-    let names: Vec<&str> = a.summary.entries().iter().map(|(n, _)| *n).collect();
+    let entries = a.summary.entries();
+    let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_ref()).collect();
     for n in ["tracking_error_xy_max_m", "tracking_error_xy_final_m", "distance_walked_m", "clamped_ik_references", "gait_switches", "min_feet_on_ground"] {
         assert!(names.contains(&n), "{n} missing from the summary");
     }
@@ -717,18 +719,18 @@ fn overrides_set_fields_and_joint_friction_for_every_leg() {
     }
     let unchanged = Scenario::from_file(scenarios_dir().join("validation_tripod_1_5cm.toml")).unwrap();
     for leg in 0..6 {
-        let (f, g) = (s.robot.friction(leg, Joint::Rotation), unchanged.robot.friction(leg, Joint::Rotation));
+        let (f, g) = (s.robot.friction(leg, PantographJoint::Rotation), unchanged.robot.friction(leg, PantographJoint::Rotation));
         assert_eq!((f.tau_f_d_plus, f.f_v_minus), (8.04, 16.17));
         assert_eq!((f.tau_f_d_minus, f.f_v_plus), (g.tau_f_d_minus, g.f_v_plus), "keys left out keep the per-leg values");
-        let h = s.robot.friction(leg, Joint::Horizontal);
+        let h = s.robot.friction(leg, PantographJoint::Horizontal);
         let a = h.load_dependence.unwrap();
         assert_eq!((h.f_v_plus, a.a_2_plus, a.a_1_minus), (0.0, 5.5, -2.0));
-        assert_eq!(a.a_2_minus, unchanged.robot.friction(leg, Joint::Horizontal).load_dependence.unwrap().a_2_minus);
+        assert_eq!(a.a_2_minus, unchanged.robot.friction(leg, PantographJoint::Horizontal).load_dependence.unwrap().a_2_minus);
     }
     // The effective text is kept (results folders hold what ran) and reads back the same.
     assert!(s.text.contains("vx_m_s = 0.01") && s.text.starts_with('#'), "{}", s.text);
     let again = Scenario::from_str(&s.text, "effective.toml", &scenarios_dir()).unwrap();
-    assert_eq!(again.robot.friction(3, Joint::Horizontal), s.robot.friction(3, Joint::Horizontal));
+    assert_eq!(again.robot.friction(3, PantographJoint::Horizontal), s.robot.friction(3, PantographJoint::Horizontal));
 }
 
 #[test]
@@ -799,4 +801,28 @@ fn walking_orders_the_friction_models() {
     assert!(xi_load > 1.05 * xi_dry, "the load dependence raises xi: {xi_load} vs {xi_dry}");
     assert!((xi_lugre / xi_dry - 1.0).abs() < 0.15, "LuGre {xi_lugre} vs dry/viscous {xi_dry}");
     assert!(dry.energy_friction_j > 0.6 * dry.energy_electrical_j, "friction dominates (Section 6.4): {} of {} J", dry.energy_friction_j, dry.energy_electrical_j);
+}
+
+/// Every per-leg column that is not a joint's (`phase[l]`, `Fz[f]`, `F_gnd_est[l]`, ...) is a
+/// name no joint may take (`hexapod::joints::RESERVED_NAMES`), and a joint's columns are its
+/// name with a prefix or a suffix joined by `_`, which `LegJoints::new` keeps apart: so no two
+/// of a robot's columns can share a name. Runs that record every column group: walking (gait),
+/// ground detection and PI motions with LuGre bristles.
+#[test]
+fn per_leg_columns_outside_the_joints_are_reserved_names() {
+    let joints = hexadyn::description::RobotDescription::amru5().joints.names;
+    let mut quantities = std::collections::BTreeSet::new();
+    for name in ["free_gait_five_legs", "ground_detection", "leg_sine"] {
+        let r = run_scenario(&short(name, 0.05), |_| {}).unwrap();
+        for c in &r.series.columns {
+            let Some((quantity, _)) = c.name.split_once('[') else { continue };
+            let of_a_joint = joints.names().any(|j| quantity == j || quantity.ends_with(&format!("_{j}")) || quantity.starts_with(&format!("{j}_")));
+            if !of_a_joint {
+                quantities.insert(quantity.to_string());
+            }
+        }
+    }
+    let unlisted: Vec<_> = quantities.iter().filter(|q| !hexadyn::hexapod::joints::RESERVED_NAMES.contains(&q.as_str())).collect();
+    assert!(unlisted.is_empty(), "per-leg columns missing from RESERVED_NAMES: {unlisted:?}");
+    assert!(quantities.len() >= 14, "{quantities:?}");
 }

@@ -9,7 +9,7 @@ use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, JointControl, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
 use hexadyn::description::RobotDescription;
-use hexadyn::hexapod::Joint;
+use hexadyn::hexapod::PantographJoint;
 
 fn model(friction: FrictionModel, tweak: impl FnOnce(&mut ModelOptions)) -> Arc<RobotModel> {
     let d = RobotDescription::amru5();
@@ -81,14 +81,14 @@ fn ramp_at_80_percent_of_no_load_speed() {
         motor.r_bridge = 0.0;
     }
     let leg = 1;
-    let k = 3 * leg + Joint::Vertical as usize; // q_v of leg 1 among the 18 joints
+    let k = 3 * leg + PantographJoint::Vertical as usize; // q_v of leg 1 among the 18 joints
     let mut base = tripod_stance();
     base[k] = 0.045;
     let mut q = m.touching_ground(&base);
     q[2] += 0.5; // the whole robot in the air, body held by nothing but its own dynamics for 0.6 s
     let qd = vec![0.0; q.len()];
     let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::from_description(&d, &m.options)).unwrap();
-    let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(Joint::Vertical);
+    let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(PantographJoint::Vertical);
     let motions = vec![(k, JointMotion::Ramp { rate, start_s: 0.0, stop_s: 10.0 })];
     let mut controller = JointPiController { pis: pis(&d), references: JointReferences { base, motions } };
     let mut worst_u: f64 = 0.0;

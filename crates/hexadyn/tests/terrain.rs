@@ -25,7 +25,7 @@ fn short_walk(terrain: &str) -> String {
 }
 
 fn number(s: &hexadyn::scenario::Summary, name: &str) -> f64 {
-    match s.entries().into_iter().find(|(n, _)| *n == name).map(|(_, v)| v) {
+    match s.entries().into_iter().find(|(n, _)| n == name).map(|(_, v)| v) {
         Some(SummaryValue::Number(x)) => x,
         v => panic!("{name}: {v:?}"),
     }

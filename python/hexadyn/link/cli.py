@@ -81,9 +81,8 @@ def _save_plots(results, folder: Path) -> None:
     and 2, the gait diagram, the averaged power and the energy breakdown (not the trajectory:
     the robot has no navigation system to measure its body position)."""
     from hexadyn import atomic, energy, plots
-    from hexadyn.vocabulary import JOINT_TYPES
 
-    figures = {f"leg{leg}_{j}": plots.joint_figure(results, leg, j) for leg in plots.DEFAULT_LEGS for j in JOINT_TYPES}
+    figures = {f"leg{leg}_{j}": plots.joint_figure(results, leg, j) for leg in plots.DEFAULT_LEGS for j in results.joints.names}
     if energy.foot_phases(results) is not None:
         figures["gait_diagram"] = plots.gait_diagram(results)
     figures["averaged_power"] = plots.averaged_power_figure(results)

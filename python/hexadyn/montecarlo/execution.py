@@ -19,7 +19,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Iterable, Iterator, Mapping, Protocol
 
-from hexadyn.montecarlo.storage import SUMMARY_COLUMNS, RunKey
+from hexadyn.montecarlo.storage import PER_JOINT_COLUMNS, SUMMARY_COLUMNS, RunKey
 
 __all__ = ["Executor", "ProcessPool", "Ray", "simulate_run"]
 
@@ -35,13 +35,18 @@ WALKS_PER_TASK = 4
 
 
 def simulate_run(scenario: str, overrides: Mapping[str, Any]) -> dict[str, Any]:
-    """Runs one simulation (summary only) and returns its outcome."""
+    """Runs one simulation (summary only) and returns its outcome; the per-joint entries of the
+    robot's joints go to the :data:`~hexadyn.montecarlo.storage.PER_JOINT_COLUMNS` in order."""
     from hexadyn import _core
+    from hexadyn.vocabulary import Joints
 
     try:
-        summary = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)["summary"]
+        raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
     except ValueError as exc:
         return {"status": "failed", "error": " ".join(str(exc).split())}
+    summary = dict(raw["summary"])
+    names = Joints.of_robot(raw["robot"]).names
+    summary.update(zip(PER_JOINT_COLUMNS, (summary[f"energy_electrical_{name}_j"] for name in names)))
     return {"status": "ok", "summary": {c: summary[c] for c in SUMMARY_COLUMNS}}
 
 

@@ -29,15 +29,18 @@ DATABASE_FILE = "runs.sqlite"
 #: Identifies a hexadyn Monte Carlo folder in campaign.json.
 FORMAT = "hexadyn-montecarlo"
 
+#: The database columns of the split of E per joint of a leg, in the robot's joint order: the
+#: summary entries ``energy_electrical_{name}_j`` of the robot's joints, stored under AMRU5's
+#: names (the campaign format is the same for every robot).
+PER_JOINT_COLUMNS = ("energy_electrical_q_r_j", "energy_electrical_q_v_j", "energy_electrical_q_h_j")
+
 #: Summary entries of a run kept in the database (``_core.run_scenario(...)["summary"]``):
-#: ξ (Eq. 6.6), E and its split per joint type, distance, mass, averaged power, Joule and
-#: friction losses, the energy balance error, the simulated and the wall time.
+#: ξ (Eq. 6.6), E and its split per joint (:data:`PER_JOINT_COLUMNS`), distance, mass, averaged
+#: power, Joule and friction losses, the energy balance error, the simulated and the wall time.
 SUMMARY_COLUMNS = (
     "specific_resistance",
     "energy_electrical_j",
-    "energy_electrical_q_r_j",
-    "energy_electrical_q_v_j",
-    "energy_electrical_q_h_j",
+    *PER_JOINT_COLUMNS,
     "energy_joule_j",
     "energy_friction_j",
     "energy_balance_error_relative",

@@ -13,7 +13,7 @@ import numpy as np
 import viser
 import viser.uplot
 
-from hexadyn.view.data import JOINTS, LEGS, Run, decimation
+from hexadyn.view.data import LEGS, Run, decimation
 from hexadyn.vocabulary import FAILED, LANDING, SUPPORT, SWING, TAKEOFF
 
 #: Most samples per chart (the panel is a few hundred pixels wide).
@@ -37,7 +37,7 @@ def signal_groups(run: Run) -> dict[str, SeriesOf]:
     have = set(run.columns)
 
     def every(pattern: str) -> bool:
-        return all(pattern.format(j=j, l=leg) in have for j in JOINTS for leg in range(LEGS))
+        return all(pattern.format(j=j, l=leg) in have for j in run.joints.names for leg in range(LEGS))
 
     groups: dict[str, SeriesOf] = {}
     if every("{j}_ref[{l}]"):
@@ -107,14 +107,14 @@ def _spike(y_range: np.ndarray, n: int, k: int) -> np.ndarray:
 
 
 class SignalCharts:
-    """The three joint charts (q_r, q_v, q_h) of one leg for one signal group."""
+    """The three joint charts (q_r, q_v, q_h on AMRU5) of one leg for one signal group."""
 
     def __init__(self, gui: viser.GuiApi, run: Run, group: str, leg: int):
         series_of = signal_groups(run)[group]
         rows = decimation(run.t.size, PLOT_POINTS)
         t = run.t[rows]
         self.charts = []
-        for j in JOINTS:
+        for j in run.joints.names:
             series = [(label, _evaluate(run, terms, rows)) for label, terms in series_of(leg, j)]
             self.charts.append(Chart(gui, f"{group}: {series[0][0]}", t, series, height=150))
 

@@ -18,12 +18,16 @@ import numpy as np
 from hexadyn import vocabulary
 from hexadyn.results import FORMAT, METADATA_FILE, TIMESERIES_FILE
 
-#: Generalized coordinates in the engine's order (Eq. 3.51): body pose, then q_r q_v q_h per leg
-#: (the number of legs and the joint names are the engine's, from :mod:`hexadyn.vocabulary`).
+#: The number of legs is the engine's (:mod:`hexadyn.vocabulary`); the joint names are the
+#: robot's (``Run.joints``).
 LEGS = len(vocabulary.LEGS)
-JOINTS = vocabulary.JOINT_TYPES
 POSE_COLUMNS = ["X", "Y", "Z", "yaw", "pitch", "roll"]
-Q_COLUMNS = POSE_COLUMNS + [f"{j}[{leg}]" for leg in range(LEGS) for j in JOINTS]
+
+
+def q_columns(joints: vocabulary.Joints) -> list[str]:
+    """Generalized coordinates in the engine's order (Eq. 3.51): body pose, then the robot's
+    three joints per leg (q_r, q_v, q_h on AMRU5)."""
+    return POSE_COLUMNS + [f"{j}[{leg}]" for leg in range(LEGS) for j in joints.names]
 
 
 class ViewError(ValueError):
@@ -92,13 +96,18 @@ class Run:
             raise ViewError(f"{meta_path}: not hexadyn results metadata (format {found!r}, expected {FORMAT!r})")
         if not self.metadata.get("robot"):
             raise ViewError(f"{meta_path}: no robot description (key 'robot')")
+        try:
+            self.joints = vocabulary.Joints.of_robot(self.metadata["robot"], f"{meta_path} (robot)")
+        except ValueError as exc:
+            raise ViewError(str(exc)) from exc
+        q_names = q_columns(self.joints)
         self._parquet = pq.ParquetFile(table_path)
         self.columns: list[str] = list(self._parquet.schema_arrow.names)
-        missing = [c for c in ["t", *Q_COLUMNS, *FOOT_COLUMNS, *FORCE_COLUMNS] if c not in self.columns]
+        missing = [c for c in ["t", *q_names, *FOOT_COLUMNS, *FORCE_COLUMNS] if c not in self.columns]
         if missing:
             raise ViewError(f"{table_path}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
         self.name: str = self.metadata.get("scenario_name") or self.folder.name
-        wanted = ["t", *Q_COLUMNS, *FOOT_COLUMNS, *FORCE_COLUMNS]
+        wanted = ["t", *q_names, *FOOT_COLUMNS, *FORCE_COLUMNS]
         self.has_phases = all(c in self.columns for c in PHASE_COLUMNS)
         self.has_reference = all(c in self.columns for c in REFERENCE_COLUMNS)
         wanted += PHASE_COLUMNS if self.has_phases else []
@@ -107,7 +116,7 @@ class Run:
         self.t = data["t"]
         if self.t.size < 1:
             raise ViewError(f"{table_path}: no rows")
-        self.q = np.column_stack([data[c] for c in Q_COLUMNS])
+        self.q = np.column_stack([data[c] for c in q_names])
         self.recorded_feet = np.column_stack([data[c] for c in FOOT_COLUMNS]).reshape(-1, LEGS, 3)
         self.forces = np.column_stack([data[c] for c in FORCE_COLUMNS]).reshape(-1, LEGS, 3)
         self.phases = np.column_stack([data[c] for c in PHASE_COLUMNS]).astype(np.int8) if self.has_phases else np.full((self.t.size, LEGS), -1, np.int8)

@@ -45,7 +45,7 @@ use super::pi_design::{JointPlant, PiDesign};
 use crate::physics::FlatGround;
 use crate::hexapod::{joint_index, DOF};
 use crate::description::RobotDescription;
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::{JointKind, PantographJoint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions, Robot, RobotModel};
 use crate::sim::{linearize, System};
 
@@ -143,7 +143,7 @@ impl LegLinearization {
     /// The largest joint velocities, the motors' no-load speed over the reductions (Table 3.4):
     /// Section 4.3.2 computes the tangent damping there to maximize C(q, q').
     pub fn max_velocities(description: &RobotDescription) -> [f64; 3] {
-        Joint::ALL.map(|j| description.motor.no_load_speed_rad_per_s() / description.reduction(j))
+        PantographJoint::ALL.map(|j| description.motor.no_load_speed_rad_per_s() / description.reduction(j))
     }
 
     /// Back-emf damping C_emf = diag((n k_t)² / r) (Eq. 4.10) for a circuit resistance `r`.
@@ -187,9 +187,11 @@ impl DesignResistance {
 }
 
 /// Plant and controller of one joint.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct JointDesign {
-    pub joint: Joint,
+    /// The joint's name in the robot description (`[joints] names`) and its kind.
+    pub name: String,
+    pub kind: JointKind,
     /// Global reduction n.
     pub n: f64,
     /// J = M_ii at the neutral configuration (kg m² or kg).
@@ -233,7 +235,8 @@ pub fn design_leg_controllers_with(description: &RobotDescription, bandwidth_hz:
     let r = resistance.ohms(description);
     let c_emf_design = lin.c_emf_for(r);
     let joints = std::array::from_fn(|i| {
-        let joint = Joint::ALL[i];
+        let joint = PantographJoint::ALL[i];
+        let (name, kind) = (description.joints.names.name(i).to_string(), description.joints.names.kind(i));
         let n = lin.reductions[i];
         let inertia = lin.m[(i, i)];
         let plant = JointPlant::from_motor(inertia, n, lin.k_t, r);
@@ -241,17 +244,13 @@ pub fn design_leg_controllers_with(description: &RobotDescription, bandwidth_hz:
         let t_i = description.pi_gains(joint).t_i;
         let controller = PiDesign::for_bandwidth(&plant, bandwidth_hz, t_i);
         let controller_on_model = PiDesign::evaluate(&plant_model, controller.k, t_i);
-        JointDesign { joint, n, inertia, c_emf_design: c_emf_design[(i, i)], c_emf_model: lin.c[(i, i)], plant, plant_model, controller, controller_on_model }
+        JointDesign { name, kind, n, inertia, c_emf_design: c_emf_design[(i, i)], c_emf_model: lin.c[(i, i)], plant, plant_model, controller, controller_on_model }
     });
     LegDesign { linearization: lin, resistance, design_resistance: r, bandwidth_hz, joints }
 }
 
-fn unit(joint: Joint) -> (&'static str, &'static str) {
-    if joint.is_rotational() {
-        ("rad", "kg m2")
-    } else {
-        ("m", "kg")
-    }
+fn unit(kind: JointKind) -> (&'static str, &'static str) {
+    (kind.unit(("rad", "m")), kind.unit(("kg m2", "kg")))
 }
 
 impl fmt::Display for LegLinearization {
@@ -291,11 +290,11 @@ impl fmt::Display for LegDesign {
             "Joint", "n", "J", "C_emf (design)", "C_emf (model)", "K", "tau_m", "tau_m (model)"
         )?;
         for j in &self.joints {
-            let (q, m) = unit(j.joint);
+            let (q, m) = unit(j.kind);
             writeln!(
                 f,
                 "{:<6}{:>8.0}  {:>16}  {:>14.4e}  {:>14.4e}  {:>18}  {:>8}  {:>14}",
-                j.joint.symbol(),
+                j.name,
                 j.n,
                 format!("{:.3} {m}", j.inertia),
                 j.c_emf_design,
@@ -312,12 +311,12 @@ impl fmt::Display for LegDesign {
             "Joint", "K", "T_i (s)", "Bandwidth (Hz)", "Phase margin (°)", "Overshoot (%)", "model: BW (Hz)/PM (°)/OS (%)"
         )?;
         for j in &self.joints {
-            let (q, _) = unit(j.joint);
+            let (q, _) = unit(j.kind);
             let (c, m) = (&j.controller, &j.controller_on_model);
             writeln!(
                 f,
                 "{:<6}{:>12}  {:>7}  {:>14.2}  {:>16.1}  {:>13.1}  {:>28}",
-                j.joint.symbol(),
+                j.name,
                 format!("{:.0} V/{q}", c.k),
                 c.t_i,
                 c.bandwidth_hz,
@@ -353,9 +352,9 @@ mod tests {
         assert_eq!(d.design_resistance, 0.334);
         let thesis = [(0.031, 0.0059), (0.00075, 0.0058), (0.00088, 0.0058)];
         for (j, (k, tau)) in d.joints.iter().zip(thesis) {
-            within(&format!("{} gain", j.joint), j.plant.gain, k, 0.05);
-            within(&format!("{} tau_m", j.joint), j.plant.time_constant, tau, 0.05);
-            assert!((5.7e-3..=6.0e-3).contains(&j.plant.time_constant), "{}: tau_m = {}", j.joint, j.plant.time_constant);
+            within(&format!("{} gain", j.name), j.plant.gain, k, 0.05);
+            within(&format!("{} tau_m", j.name), j.plant.time_constant, tau, 0.05);
+            assert!((5.7e-3..=6.0e-3).contains(&j.plant.time_constant), "{}: tau_m = {}", j.name, j.plant.time_constant);
         }
     }
 
@@ -365,7 +364,7 @@ mod tests {
     fn leg_design_c_emf_matches_eq_4_13() {
         let d = design_leg_controllers(&amru5(), DEFAULT_BANDWIDTH_HZ);
         for (j, thesis) in d.joints.iter().zip([3388.0, 5.72e6, 4.12e6]) {
-            within(&format!("{} C_emf (coil R)", j.joint), j.c_emf_design, thesis, 0.10);
+            within(&format!("{} C_emf (coil R)", j.name), j.c_emf_design, thesis, 0.10);
             assert!(j.c_emf_design < thesis, "k_t = 19.4e-3 < 0.02 puts C_emf below Eq. 4.13");
             // The model's circuit (coil + H-bridge) damps less, by R / (R + R_bridge).
             assert_relative_eq!(j.c_emf_model, j.c_emf_design * 0.334 / 0.934, max_relative = 1e-6);
@@ -396,14 +395,14 @@ mod tests {
         let d = design_leg_controllers(&description, DEFAULT_BANDWIDTH_HZ);
         println!("{d}");
         let table = [(483.0, 2.94, 77.3, 9.5), (19863.0, 2.92, 77.4, 9.6), (16854.0, 2.91, 77.4, 9.6)];
-        for (j, (k, bw, pm, os)) in d.joints.iter().zip(table) {
+        for ((j, joint), (k, bw, pm, os)) in d.joints.iter().zip(PantographJoint::ALL).zip(table) {
             let c = &j.controller;
             assert_eq!(c.t_i, 0.5);
-            assert_eq!(description.pi_gains(j.joint).k, k, "the description holds Table 4.1");
-            within(&format!("{} K_p", j.joint), c.k, k, 0.10);
-            within(&format!("{} bandwidth", j.joint), c.bandwidth_hz, bw, 0.10);
-            within(&format!("{} phase margin", j.joint), c.phase_margin_deg, pm, 0.10);
-            within(&format!("{} overshoot", j.joint), c.overshoot_percent, os, 0.10);
+            assert_eq!(description.pi_gains(joint).k, k, "the description holds Table 4.1");
+            within(&format!("{} K_p", j.name), c.k, k, 0.10);
+            within(&format!("{} bandwidth", j.name), c.bandwidth_hz, bw, 0.10);
+            within(&format!("{} phase margin", j.name), c.phase_margin_deg, pm, 0.10);
+            within(&format!("{} overshoot", j.name), c.overshoot_percent, os, 0.10);
         }
     }
 

@@ -5,13 +5,13 @@ use std::f64::consts::TAU;
 use super::interface::{Command, Controller, Measurements};
 use super::DigitalPi;
 use crate::description::RobotDescription;
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::{PantographJoint, JOINTS};
 
 /// The 18 digital PI of a robot (gains K, T_i of its description, Table 4.1 for AMRU5) at the
 /// control period `dt`, joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
 pub fn joint_pis(robot: &RobotDescription, dt: f64) -> [DigitalPi; JOINTS] {
     std::array::from_fn(|k| {
-        let g = robot.pi_gains(Joint::ALL[k % 3]);
+        let g = robot.pi_gains(PantographJoint::ALL[k % 3]);
         DigitalPi::new(g.k, g.t_i, dt)
     })
 }

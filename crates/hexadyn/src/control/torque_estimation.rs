@@ -18,7 +18,7 @@
 use super::interface::Measurements;
 use super::low_pass::DigitalLowPass;
 use crate::description::RobotDescription;
-use crate::hexapod::{joint_torques, Joint, Mechanics, MechanicsParameters, StillBody, JOINTS};
+use crate::hexapod::{joint_torques, PantographJoint, Mechanics, MechanicsParameters, StillBody, JOINTS};
 use crate::mbs::Data;
 use crate::physics::DryViscous;
 
@@ -66,12 +66,12 @@ impl TorqueEstimator {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
         let data = Data::new(&mechanics.model);
         // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters of Table 5.3.
-        let friction = std::array::from_fn(|k| d.friction(k / 3, Joint::ALL[k % 3]).dry_viscous());
+        let friction = std::array::from_fn(|k| d.friction(k / 3, PantographJoint::ALL[k % 3]).dry_viscous());
         TorqueEstimator {
             mechanics,
             data,
             friction,
-            torque_per_ampere: std::array::from_fn(|k| d.joint_torque_per_ampere(Joint::ALL[k % 3])),
+            torque_per_ampere: std::array::from_fn(|k| d.joint_torque_per_ampere(PantographJoint::ALL[k % 3])),
             dt,
             positions: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
             currents: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],

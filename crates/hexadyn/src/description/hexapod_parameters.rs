@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 
 use super::{RigidBodyTable, RobotDescription};
-use crate::hexapod::{Inertia, Joint, JointLimits, LegKinematics, LegKinematicsError, MechanicsParameters, PantographGeometry};
+use crate::hexapod::{Inertia, PantographJoint, JointLimits, LegKinematics, LegKinematicsError, MechanicsParameters, PantographGeometry};
 
 impl MechanicsParameters {
     /// The mechanics of a robot description (SI units). Interpretations of the lost figures
@@ -44,7 +44,7 @@ impl MechanicsParameters {
 impl JointLimits {
     /// The ranges of a robot description ([`RobotDescription::joint_range`], SI).
     pub fn from_description(d: &RobotDescription) -> Self {
-        let r = Joint::ALL.map(|j| d.joint_range(j));
+        let r = PantographJoint::ALL.map(|j| d.joint_range(j));
         JointLimits { lower: Vector3::new(r[0].0, r[1].0, r[2].0), upper: Vector3::new(r[0].1, r[1].1, r[2].1) }
     }
 }

@@ -19,10 +19,10 @@
 //!
 //! ```
 //! use hexadyn::description::RobotDescription;
-//! use hexadyn::hexapod::Joint;
+//! use hexadyn::hexapod::PantographJoint;
 //! let robot = RobotDescription::amru5();
 //! assert_eq!(robot.legs.len(), 6);
-//! let f = robot.friction(0, Joint::Vertical);
+//! let f = robot.friction(0, PantographJoint::Vertical);
 //! assert!(f.tau_f_d_plus > 0.0 && f.tau_f_d_minus < 0.0);
 //! ```
 

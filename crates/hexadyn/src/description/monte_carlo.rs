@@ -2,7 +2,7 @@
 
 use super::tables::{LoadDependenceTable, MonteCarloTable, RobotDescription};
 use super::values::{Gaussian, PerLeg, PerLegMaybe};
-use crate::hexapod::Joint;
+use crate::hexapod::PantographJoint;
 
 /// Monte Carlo distributions of the Eq. 5.12 coefficients, computed from Table 5.5 like
 /// Table 6.7 was (mean and n-1 standard deviation of the leg means, excluded legs left out).
@@ -46,17 +46,17 @@ impl MonteCarloTable {
 impl RobotDescription {
     /// Distributions of Table 6.7 for one joint kind, as (tau_f_d^+, f_v^+, tau_f_d^-, f_v^-);
     /// the viscous entries are None for q_h (neglected in Section 6.5).
-    pub fn monte_carlo_distribution(&self, joint: Joint) -> (Gaussian, Option<Gaussian>, Gaussian, Option<Gaussian>) {
+    pub fn monte_carlo_distribution(&self, joint: PantographJoint) -> (Gaussian, Option<Gaussian>, Gaussian, Option<Gaussian>) {
         let m = &self.monte_carlo;
         match joint {
-            Joint::Rotation => (m.q_r.tau_f_d_plus_nm, Some(m.q_r.f_v_plus_nms), m.q_r.tau_f_d_minus_nm, Some(m.q_r.f_v_minus_nms)),
-            Joint::Vertical => (
+            PantographJoint::Rotation => (m.q_r.tau_f_d_plus_nm, Some(m.q_r.f_v_plus_nms), m.q_r.tau_f_d_minus_nm, Some(m.q_r.f_v_minus_nms)),
+            PantographJoint::Vertical => (
                 m.q_v.tau_f_d_plus_n,
                 Some(m.q_v.f_v_plus_ns_per_m),
                 m.q_v.tau_f_d_minus_n,
                 Some(m.q_v.f_v_minus_ns_per_m),
             ),
-            Joint::Horizontal => (m.q_h.tau_f_d_plus_n, None, m.q_h.tau_f_d_minus_n, None),
+            PantographJoint::Horizontal => (m.q_h.tau_f_d_plus_n, None, m.q_h.tau_f_d_minus_n, None),
         }
     }
 }

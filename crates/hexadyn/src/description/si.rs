@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
-use crate::hexapod::{Joint, LEG_COUNT};
+use crate::hexapod::{PantographJoint, LEG_COUNT};
 use crate::physics::{DryViscous, LoadDependence};
 
 impl MotorTable {
@@ -47,7 +47,7 @@ pub struct PiGains {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointFrictionParameters {
     pub leg: usize,
-    pub joint: Joint,
+    pub joint: PantographJoint,
     /// tau_f_d^+, dry friction (Table 5.3).
     pub tau_f_d_plus: f64,
     /// tau_f_d^- (< 0).
@@ -141,17 +141,17 @@ impl RobotDescription {
     }
 
     /// Global reduction n of a joint (Table 3.1): rad/rad for q_r, rad/m for q_v and q_h.
-    pub fn reduction(&self, joint: Joint) -> f64 {
+    pub fn reduction(&self, joint: PantographJoint) -> f64 {
         match joint {
-            Joint::Rotation => self.reductions.n_r,
-            Joint::Vertical => self.reductions.n_v_rad_per_m,
-            Joint::Horizontal => self.reductions.n_h_rad_per_m,
+            PantographJoint::Rotation => self.reductions.n_r,
+            PantographJoint::Vertical => self.reductions.n_v_rad_per_m,
+            PantographJoint::Horizontal => self.reductions.n_h_rad_per_m,
         }
     }
 
     /// k_t n: joint torque (Nm) or force (N) per ampere of motor current (Eq. 5.17), and the
     /// factor between a joint velocity and the back-emf (V per rad/s or per m/s).
-    pub fn joint_torque_per_ampere(&self, joint: Joint) -> f64 {
+    pub fn joint_torque_per_ampere(&self, joint: PantographJoint) -> f64 {
         self.motor.torque_constant_nm_per_a * self.reduction(joint)
     }
 
@@ -161,27 +161,27 @@ impl RobotDescription {
     }
 
     /// Joint range (Table 5.2) in SI: rad for q_r, m for q_v and q_h.
-    pub fn joint_range(&self, joint: Joint) -> (f64, f64) {
+    pub fn joint_range(&self, joint: PantographJoint) -> (f64, f64) {
         let r = &self.joint_ranges;
         match joint {
-            Joint::Rotation => (r.q_r_deg.min.to_radians(), r.q_r_deg.max.to_radians()),
-            Joint::Vertical => (r.q_v_m.min, r.q_v_m.max),
-            Joint::Horizontal => (r.q_h_m.min, r.q_h_m.max),
+            PantographJoint::Rotation => (r.q_r_deg.min.to_radians(), r.q_r_deg.max.to_radians()),
+            PantographJoint::Vertical => (r.q_v_m.min, r.q_v_m.max),
+            PantographJoint::Horizontal => (r.q_h_m.min, r.q_h_m.max),
         }
     }
 
     /// PI gains of a joint in SI (Table 4.1).
-    pub fn pi_gains(&self, joint: Joint) -> PiGains {
+    pub fn pi_gains(&self, joint: PantographJoint) -> PiGains {
         let k = &self.controller;
         match joint {
-            Joint::Rotation => PiGains { k: k.q_r.k_v_per_rad, t_i: k.q_r.t_i_s },
-            Joint::Vertical => PiGains { k: k.q_v.k_v_per_m, t_i: k.q_v.t_i_s },
-            Joint::Horizontal => PiGains { k: k.q_h.k_v_per_m, t_i: k.q_h.t_i_s },
+            PantographJoint::Rotation => PiGains { k: k.q_r.k_v_per_rad, t_i: k.q_r.t_i_s },
+            PantographJoint::Vertical => PiGains { k: k.q_v.k_v_per_m, t_i: k.q_v.t_i_s },
+            PantographJoint::Horizontal => PiGains { k: k.q_h.k_v_per_m, t_i: k.q_h.t_i_s },
         }
     }
 
     /// Joint-side resolution of the motor encoder: 2 pi / (impulses n), rad or m.
-    pub fn encoder_resolution(&self, joint: Joint) -> f64 {
+    pub fn encoder_resolution(&self, joint: PantographJoint) -> f64 {
         2.0 * PI / (f64::from(self.controller.encoder_impulses_per_rev) * self.reduction(joint))
     }
 
@@ -202,13 +202,13 @@ impl RobotDescription {
     ///
     /// # Panics
     /// If `leg` is not 0..5.
-    pub fn friction(&self, leg: usize, joint: Joint) -> JointFrictionParameters {
+    pub fn friction(&self, leg: usize, joint: PantographJoint) -> JointFrictionParameters {
         assert!(leg < LEG_COUNT, "leg {leg} does not exist (ids 0..5)");
         let f = &self.friction;
         let (dp, vp, dm, vm) = match joint {
-            Joint::Rotation => (&f.q_r.tau_f_d_plus_nm, &f.q_r.f_v_plus_nms, &f.q_r.tau_f_d_minus_nm, &f.q_r.f_v_minus_nms),
-            Joint::Vertical => (&f.q_v.tau_f_d_plus_n, &f.q_v.f_v_plus_ns_per_m, &f.q_v.tau_f_d_minus_n, &f.q_v.f_v_minus_ns_per_m),
-            Joint::Horizontal => (&f.q_h.tau_f_d_plus_n, &f.q_h.f_v_plus_ns_per_m, &f.q_h.tau_f_d_minus_n, &f.q_h.f_v_minus_ns_per_m),
+            PantographJoint::Rotation => (&f.q_r.tau_f_d_plus_nm, &f.q_r.f_v_plus_nms, &f.q_r.tau_f_d_minus_nm, &f.q_r.f_v_minus_nms),
+            PantographJoint::Vertical => (&f.q_v.tau_f_d_plus_n, &f.q_v.f_v_plus_ns_per_m, &f.q_v.tau_f_d_minus_n, &f.q_v.f_v_minus_ns_per_m),
+            PantographJoint::Horizontal => (&f.q_h.tau_f_d_plus_n, &f.q_h.f_v_plus_ns_per_m, &f.q_h.tau_f_d_minus_n, &f.q_h.f_v_minus_ns_per_m),
         };
         let (tau_f_d_plus, tau_f_d_minus) = (dp.mu[leg], dm.mu[leg]);
         let viscous = |v: f64| match f.negative_viscous {
@@ -216,7 +216,7 @@ impl RobotDescription {
             NegativeViscousRule::Keep => v,
         };
         let (tau_f_s_plus, tau_f_s_minus) = match joint {
-            Joint::Vertical => {
+            PantographJoint::Vertical => {
                 let (p, m) = self
                     .vertical_stiction_measured(leg, f.vertical_stiction_load_kg)
                     .expect("validated: the stiction load case exists");
@@ -226,7 +226,7 @@ impl RobotDescription {
             }
             _ => (tau_f_d_plus, tau_f_d_minus),
         };
-        let load_dependence = (joint == Joint::Horizontal).then(|| {
+        let load_dependence = (joint == PantographJoint::Horizontal).then(|| {
             let a = &f.q_h.load_dependence;
             let a_1_plus = a.a_1_plus_n_per_kg.mu[leg].value().unwrap_or(0.0);
             let a_1_minus = a.a_1_minus_n_per_kg.mu[leg].value().unwrap_or(match f.missing_a1_minus {
@@ -251,7 +251,7 @@ impl RobotDescription {
             f_v_minus: viscous(vm.mu[leg]),
             f_v_plus_measured: vp.mu[leg],
             f_v_minus_measured: vm.mu[leg],
-            q_st: (joint == Joint::Vertical).then_some(f.lugre.q_st_v_m_per_s),
+            q_st: (joint == PantographJoint::Vertical).then_some(f.lugre.q_st_v_m_per_s),
             sigma_0: f.lugre.sigma_0,
             sigma_1: f.lugre.sigma_1,
             v_d: f.lugre.v_d,

@@ -16,6 +16,7 @@ use super::values::{
     PerLegMaybe, PhaseMargin, PwmBits, Shapes, Sweep, ToothCount,
 };
 use crate::fields::{seq, Bound, Finite, NonNegative, Positive, Violation};
+use crate::hexapod::{LegJoints, PantographJoint};
 
 /// The whole robot description, mirroring `robots/amru5.toml`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -26,6 +27,9 @@ pub struct RobotDescription {
     pub name: String,
     /// The six legs, sorted by id after loading (NOTES.md, Fig. 2.14).
     pub legs: Vec<LegTable>,
+    /// The names of a leg's joints; `q_r, q_v, q_h` when the table is absent.
+    #[serde(default)]
+    pub joints: JointsTable,
     /// Table 2.1, Table B.1.
     pub geometry: GeometryTable,
     /// Table B.2.
@@ -70,6 +74,30 @@ pub struct LegTable {
     /// Angle of the leg from x_b about z_b, degrees (NOTES.md: 0 at +30, 2 at +90, ...).
     #[serde(deserialize_with = "LegAngle::checked")]
     pub angle_deg: f64,
+}
+
+/// `[joints]`: the names of a leg's three actuated joints, in the order of the pantograph's
+/// q_r (revolute), q_v and q_h (prismatic): the names of the results columns (`q_v[2]`,
+/// `u_q_v[2]`), plots, power tables and scenario motions. The description's own joint tables
+/// (`[controller.q_r]`, `[friction.q_v]`, ...) keep the thesis symbols.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct JointsTable {
+    #[serde(deserialize_with = "pantograph_joint_names")]
+    pub names: LegJoints,
+}
+
+impl Default for JointsTable {
+    fn default() -> Self {
+        JointsTable { names: PantographJoint::leg_joints(PantographJoint::ALL.map(|j| j.symbol().to_string())).expect("the thesis symbols are valid joint names") }
+    }
+}
+
+fn pantograph_joint_names<'de, D: Deserializer<'de>>(d: D) -> Result<LegJoints, D::Error> {
+    let names = Vec::<String>::deserialize(d)?;
+    let shown = format!("{names:?}");
+    let three: [String; 3] = names.try_into().map_err(|n: Vec<String>| Violation::new(&shown, &format!("{} names", n.len()), "three names, for q_r, q_v and q_h").into_error())?;
+    PantographJoint::leg_joints(three).map_err(|e| Violation::new(&shown, &e.to_string(), "three distinct identifiers that are not per-leg column names").into_error())
 }
 
 /// `[geometry]`, Table 2.1 and Table B.1 (metres).

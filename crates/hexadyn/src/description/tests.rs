@@ -4,7 +4,7 @@
 use std::f64::consts::PI;
 
 use super::*;
-use crate::hexapod::Joint;
+use crate::hexapod::PantographJoint;
 use approx::assert_relative_eq;
 
 fn amru5() -> RobotDescription {
@@ -50,43 +50,43 @@ fn motor_and_reductions_in_si() {
     assert_relative_eq!(r.motor.inductance_h(), 0.09e-3, epsilon = 1e-15);
     assert_relative_eq!(r.motor.rotor_inertia_kg_m2(), 6.55e-6, epsilon = 1e-15);
     assert_relative_eq!(r.circuit_resistance_ohm(), 0.934, epsilon = 1e-12);
-    assert_eq!(r.reduction(Joint::Rotation), 1682.0);
-    assert_eq!(r.reduction(Joint::Vertical), 69115.0);
-    assert_eq!(r.reduction(Joint::Horizontal), 58643.0);
+    assert_eq!(r.reduction(PantographJoint::Rotation), 1682.0);
+    assert_eq!(r.reduction(PantographJoint::Vertical), 69115.0);
+    assert_eq!(r.reduction(PantographJoint::Horizontal), 58643.0);
     // Eq. 4.13 with k_t = 0.02 gives C_emf = 3388 for q_r; with 19.4e-3 about 6 % less.
-    let c_emf = r.joint_torque_per_ampere(Joint::Rotation).powi(2) / r.motor.resistance_ohm;
+    let c_emf = r.joint_torque_per_ampere(PantographJoint::Rotation).powi(2) / r.motor.resistance_ohm;
     assert!((c_emf / 3388.0 - 0.94).abs() < 0.01, "C_emf = {c_emf}");
     // Section 5.6: 100 N vertically at the foot ~ 0.4 A (100 N x 6 / (k_t n_v))
-    let amps = 100.0 * 6.0 / r.joint_torque_per_ampere(Joint::Vertical);
+    let amps = 100.0 * 6.0 / r.joint_torque_per_ampere(PantographJoint::Vertical);
     assert!((amps - 0.45).abs() < 0.05, "{amps}");
-    let (lo, hi) = r.joint_range(Joint::Rotation);
+    let (lo, hi) = r.joint_range(PantographJoint::Rotation);
     assert_relative_eq!(hi, 25f64.to_radians(), epsilon = 1e-15);
     assert_relative_eq!(lo, -25f64.to_radians(), epsilon = 1e-15);
-    assert_eq!(r.joint_range(Joint::Horizontal), (0.005, 0.055));
-    assert_eq!(r.pi_gains(Joint::Vertical), PiGains { k: 19863.0, t_i: 0.5 });
-    assert_relative_eq!(r.encoder_resolution(Joint::Rotation), 2.0 * PI / (500.0 * 1682.0));
+    assert_eq!(r.joint_range(PantographJoint::Horizontal), (0.005, 0.055));
+    assert_eq!(r.pi_gains(PantographJoint::Vertical), PiGains { k: 19863.0, t_i: 0.5 });
+    assert_relative_eq!(r.encoder_resolution(PantographJoint::Rotation), 2.0 * PI / (500.0 * 1682.0));
 }
 
 #[test]
 fn friction_rules_of_section_6_1() {
     let r = amru5();
     // Table 5.3 spot checks
-    let f = r.friction(3, Joint::Rotation);
+    let f = r.friction(3, PantographJoint::Rotation);
     assert_eq!((f.tau_f_d_plus, f.tau_f_d_minus), (14.9, -15.6));
     assert_eq!((f.tau_f_s_plus, f.tau_f_s_minus), (14.9, -15.6));
     assert!(f.q_st.is_none() && f.load_dependence.is_none());
     // negative viscous forced to zero, measured kept
-    let f = r.friction(5, Joint::Rotation);
+    let f = r.friction(5, PantographJoint::Rotation);
     assert_eq!((f.f_v_plus, f.f_v_plus_measured), (0.0, -0.3));
-    let f = r.friction(0, Joint::Horizontal);
+    let f = r.friction(0, PantographJoint::Horizontal);
     assert_eq!((f.f_v_plus, f.f_v_plus_measured, f.f_v_minus), (0.0, -4112.7, 247.5));
     // vertical stiction of the 10 kg case; legs 1 and 3 minus sense from Table 5.3
-    let f = r.friction(0, Joint::Vertical);
+    let f = r.friction(0, PantographJoint::Vertical);
     assert_eq!((f.tau_f_s_plus, f.tau_f_s_minus), (673.0, -679.5));
     assert_eq!(f.q_st, Some(1e-4));
-    let f = r.friction(1, Joint::Vertical);
+    let f = r.friction(1, PantographJoint::Vertical);
     assert_eq!((f.tau_f_s_plus, f.tau_f_s_minus), (482.6, -351.6));
-    let f = r.friction(3, Joint::Vertical);
+    let f = r.friction(3, PantographJoint::Vertical);
     assert_eq!((f.tau_f_s_plus, f.tau_f_s_minus), (571.6, -381.8));
     assert_eq!(r.vertical_stiction_measured(3, 10.0), Some((Some(571.6), None)));
     assert_eq!(r.vertical_stiction_measured(5, 5.0), Some((Some(1010.4), Some(-435.8))));
@@ -97,7 +97,7 @@ fn friction_rules_of_section_6_1() {
 #[test]
 fn horizontal_load_dependence_eq_5_12() {
     let r = amru5();
-    let f = r.friction(0, Joint::Horizontal);
+    let f = r.friction(0, PantographJoint::Horizontal);
     let a = f.load_dependence.unwrap();
     assert_eq!((a.a_2_plus, a.a_2_minus, a.a_1_plus, a.a_1_minus), (3.84, -3.84, 20.3, 0.0));
     let (p, m) = f.dry_under_load(10.0);
@@ -107,7 +107,7 @@ fn horizontal_load_dependence_eq_5_12() {
     // the mirror rule
     let mut r2 = r.clone();
     r2.friction.missing_a1_minus = MissingA1MinusRule::MirrorA1Plus;
-    assert_eq!(r2.friction(1, Joint::Horizontal).load_dependence.unwrap().a_1_minus, -48.0);
+    assert_eq!(r2.friction(1, PantographJoint::Horizontal).load_dependence.unwrap().a_1_minus, -48.0);
 }
 
 #[test]
@@ -138,7 +138,7 @@ fn table_6_7_is_the_spread_of_the_leg_means() {
     let a2p = d.a_2_plus.unwrap();
     assert_relative_eq!(a2p.mu, (3.84 + 4.09 + 6.84 + 5.07 + 7.66) / 5.0, epsilon = 1e-12);
     assert!(d.a_1_minus.is_none());
-    assert_eq!(r.monte_carlo_distribution(Joint::Horizontal).1, None);
+    assert_eq!(r.monte_carlo_distribution(PantographJoint::Horizontal).1, None);
 }
 
 #[test]

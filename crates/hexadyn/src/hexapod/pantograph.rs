@@ -7,7 +7,62 @@
 
 use nalgebra::Vector2;
 
+use super::joints::{JointKind, JointNameError, LegJoints};
 use crate::mbs::{DependentFunction, DependentValue, DualNum, Jet};
+
+/// The three actuated joints of a pantograph leg (Eq. 3.51): q_r the rotation of the leg
+/// chassis about the vertical axis, q_v the vertical and q_h the horizontal ball-screw nut
+/// positions. Their symbols name the joint tables of the pantograph robot description
+/// (`[controller.q_r]`, `[friction.q_v]`, ...); the results columns use the robot's
+/// [`LegJoints`], which on AMRU5 carries the same names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PantographJoint {
+    /// q_r, rad (joint torques in Nm).
+    Rotation,
+    /// q_v, m (joint "torques" are forces in N).
+    Vertical,
+    /// q_h, m (joint "torques" are forces in N).
+    Horizontal,
+}
+
+impl PantographJoint {
+    /// The three joints in the thesis order (q_r, q_v, q_h).
+    pub const ALL: [PantographJoint; 3] = [PantographJoint::Rotation, PantographJoint::Vertical, PantographJoint::Horizontal];
+
+    /// Thesis symbol: `q_r`, `q_v` or `q_h` (also the description's table names and the
+    /// default joint names of a pantograph robot).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            PantographJoint::Rotation => "q_r",
+            PantographJoint::Vertical => "q_v",
+            PantographJoint::Horizontal => "q_h",
+        }
+    }
+
+    /// Revolute for q_r (radians and Nm), prismatic for the nuts (metres and N).
+    pub fn kind(self) -> JointKind {
+        match self {
+            PantographJoint::Rotation => JointKind::Revolute,
+            PantographJoint::Vertical | PantographJoint::Horizontal => JointKind::Prismatic,
+        }
+    }
+
+    /// True for q_r (radians and Nm), false for the translational joints (metres and N).
+    pub fn is_rotational(self) -> bool {
+        self.kind() == JointKind::Revolute
+    }
+
+    /// The pantograph's joint vocabulary with the given names (in the order q_r, q_v, q_h).
+    pub fn leg_joints(names: [String; 3]) -> Result<LegJoints, JointNameError> {
+        LegJoints::new(names, PantographJoint::ALL.map(PantographJoint::kind))
+    }
+}
+
+impl std::fmt::Display for PantographJoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.symbol())
+    }
+}
 
 /// Lengths of the pantograph (Table 2.1, B.1), in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]

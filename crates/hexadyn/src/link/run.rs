@@ -27,6 +27,7 @@
 //! periods. A safety stop ends the run early with the rows up to it; the summary says why
 //! (`safety_stop`).
 
+use std::borrow::Cow;
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
@@ -38,10 +39,10 @@ use super::config::LinkConfig;
 use super::master::{LinkEvent, LinkStats, SafetyStop};
 use super::{LinkError, UdpPlant};
 use crate::control::{Command, Measurements};
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::{LegJoints, JOINTS};
 use crate::robot::recorder::{Recorder, TimeSeries};
 use crate::robot::simulation::run_until;
-use crate::scenario::{GaitColumns, Scenario, ScenarioController, SummaryValue};
+use crate::scenario::{per_joint_entries, GaitColumns, Scenario, ScenarioController, SummaryValue};
 
 /// How often [`run_robot`] reports progress.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(50);
@@ -51,7 +52,7 @@ const PROGRESS_INTERVAL: Duration = Duration::from_millis(50);
 pub struct RobotRun {
     pub series: TimeSeries,
     /// Totals and link figures, names with their unit as suffix.
-    pub summary: Vec<(&'static str, SummaryValue)>,
+    pub summary: Vec<(Cow<'static, str>, SummaryValue)>,
     /// Why the master stopped the robot early, if it did.
     pub stop: Option<SafetyStop>,
     pub stats: LinkStats,
@@ -141,7 +142,7 @@ fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interru
     let gait = controller.gait_columns();
     let pi = s.control.tracks_references();
     let resistance = s.robot.circuit_resistance_ohm();
-    let mut row = Row { rec: Recorder::default(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
+    let mut row = Row { rec: Recorder::default(), joints: s.robot.joints.names.clone(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
     let mut plant = UdpPlant::connect(config, &s.robot, interrupt)?;
     // As many controller updates as in a simulation: the controllers count their updates (the
     // gait integrates its body reference by Δt per update), so a missed period, which runs no
@@ -179,6 +180,8 @@ struct Sample<'a> {
 /// The recorder of a run and the totals it keeps.
 struct Row {
     rec: Recorder,
+    /// The robot's joint names and kinds (column names and units).
+    joints: LegJoints,
     gait: GaitColumns,
     pi: bool,
     resistance: f64,
@@ -189,18 +192,6 @@ struct Row {
     saturated: u64,
     commands: u64,
     tracking: [f64; 3],
-}
-
-fn joint_name(prefix: &str, k: usize, suffix: &str) -> String {
-    format!("{prefix}{}{suffix}[{}]", Joint::ALL[k % 3].symbol(), k / 3)
-}
-
-fn joint_unit(k: usize, rotational: &'static str, linear: &'static str) -> &'static str {
-    if Joint::ALL[k % 3].is_rotational() {
-        rotational
-    } else {
-        linear
-    }
 }
 
 impl Row {
@@ -237,29 +228,29 @@ impl Row {
         rec.put(x.t, || (s("t"), "s", s("control instant: period index times the control period")));
         rec.put(x.period as f64, || (s("period"), "1", s("period index (the command's sequence number modulo 2^16)")));
         for k in 0..JOINTS {
-            rec.put(x.positions[k], || (joint_name("", k, ""), joint_unit(k, "rad", "m"), format!("encoder position, leg {} (NaN: period missed)", k / 3)));
+            rec.put(x.positions[k], || (self.joints.column("", k, ""), self.joints.unit(k, ("rad", "m")), format!("encoder position, leg {} (NaN: period missed)", k / 3)));
         }
         if self.pi {
             for k in 0..JOINTS {
-                rec.put(x.references[k], || (joint_name("", k, "_ref"), joint_unit(k, "rad", "m"), format!("PI reference computed at t, leg {} (NaN: period missed)", k / 3)));
+                rec.put(x.references[k], || (self.joints.column("", k, "_ref"), self.joints.unit(k, ("rad", "m")), format!("PI reference computed at t, leg {} (NaN: period missed)", k / 3)));
             }
         }
         self.gait.record(rec);
         for k in 0..JOINTS {
-            rec.put(x.voltages[k], || (joint_name("u_", k, ""), "V", s("voltage held over the period ending at t: PWM duty / 1023 times the board's supply")));
+            rec.put(x.voltages[k], || (self.joints.column("u_", k, ""), "V", s("voltage held over the period ending at t: PWM duty / 1023 times the board's supply")));
         }
         for k in 0..JOINTS {
-            rec.put(x.currents[k], || (joint_name("i_", k, ""), "A", s("motor current measured by the slave board (NaN: period missed)")));
+            rec.put(x.currents[k], || (self.joints.column("i_", k, ""), "A", s("motor current measured by the slave board (NaN: period missed)")));
         }
         rec.put(x.supply, || (s("u_supply"), "V", s("lowest supply voltage measured by the six boards")));
         for k in 0..JOINTS {
-            rec.put(self.e_el[k], || (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy of the samples, sum of u i dt")));
+            rec.put(self.e_el[k], || (self.joints.column("E_el_", k, ""), "J", s("cumulative electrical energy of the samples, sum of u i dt")));
         }
         for k in 0..JOINTS {
-            rec.put(self.e_joule[k], || (joint_name("E_joule_", k, ""), "J", s("cumulative Joule losses of the samples, sum of (R + R_bridge) i^2 dt")));
+            rec.put(self.e_joule[k], || (self.joints.column("E_joule_", k, ""), "J", s("cumulative Joule losses of the samples, sum of (R + R_bridge) i^2 dt")));
         }
         for k in 0..JOINTS {
-            rec.put(f64::NAN, || (joint_name("E_fric_", k, ""), "J", s("friction work: not measured on the robot (NaN)")));
+            rec.put(f64::NAN, || (self.joints.column("E_fric_", k, ""), "J", s("friction work: not measured on the robot (NaN)")));
         }
         rec.put(x.lateness, || (s("lateness"), "s", s("lateness of the period's broadcast against its deadline")));
         rec.put(x.last_reply, || (s("last_reply"), "s", s("arrival of the period's last slave packet after the broadcast (NaN: period missed)")));
@@ -267,7 +258,7 @@ impl Row {
         rec.end_row();
     }
 
-    fn summary(&self, s: &Scenario, stats: &LinkStats, controller_time: &[f64], stop: Option<&SafetyStop>, wall: f64) -> Vec<(&'static str, SummaryValue)> {
+    fn summary(&self, s: &Scenario, stats: &LinkStats, controller_time: &[f64], stop: Option<&SafetyStop>, wall: f64) -> Vec<(Cow<'static, str>, SummaryValue)> {
         use SummaryValue::{Count, Number, Text};
         let rows = self.rec.rows() as u64;
         // Rows of missed periods included: one row per period.
@@ -276,7 +267,7 @@ impl Row {
         let lateness = Percentiles::of(&stats.lateness);
         let last_reply = Percentiles::of(&stats.last_reply);
         let controller = Percentiles::of(controller_time);
-        let mut v = vec![
+        let entries = [
             ("scenario", Text(s.name.clone())),
             ("control", Text(s.control.name().to_string())),
             ("plant", Text("robot link".to_string())),
@@ -308,10 +299,9 @@ impl Row {
             ("max_abs_voltage_v", Number(self.max_voltage)),
             ("saturated_fraction", Number(if self.commands > 0 { self.saturated as f64 / self.commands as f64 } else { 0.0 })),
         ];
+        let mut v: Vec<_> = entries.into_iter().map(|(n, x)| (Cow::Borrowed(n), x)).collect();
         if self.pi {
-            v.push(("max_tracking_error_q_r_rad", Number(self.tracking[0])));
-            v.push(("max_tracking_error_q_v_m", Number(self.tracking[1])));
-            v.push(("max_tracking_error_q_h_m", Number(self.tracking[2])));
+            v.extend(per_joint_entries(&self.joints, "max_tracking_error", self.tracking, ("rad", "m")));
         }
         v
     }

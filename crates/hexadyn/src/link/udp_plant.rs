@@ -24,7 +24,7 @@ use super::protocol::{Duty, SlaveReply};
 use super::LinkError;
 use crate::control::{Command, Encoder, Measurements, Plant};
 use crate::description::RobotDescription;
-use crate::hexapod::{Joint, JOINTS, LEG_COUNT};
+use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
 
 /// A period whose slave packets did not all arrive: no measurements, the controller did not run.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,7 +67,7 @@ impl UdpPlant {
         let mut master = Master::bind(config)?;
         master.start_clock();
         let replies = master.connect()?;
-        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: robot.controller.encoder_impulses_per_rev, n: robot.reduction(Joint::ALL[k % 3]) });
+        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: robot.controller.encoder_impulses_per_rev, n: robot.reduction(PantographJoint::ALL[k % 3]) });
         let mut plant = UdpPlant {
             master,
             encoders,

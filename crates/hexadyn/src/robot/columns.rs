@@ -5,7 +5,10 @@
 //! are those of the voltage held during the control period that ends at t — what the current
 //! sensors read at t —, the references (`q_*_ref`) those the controller computed at t. The
 //! names follow the thesis symbols with the leg (i, l) or foot (f) number 0..5 in brackets:
-//! `q_v[2]` is the q_v joint of leg 2.
+//! `q_v[2]` is the q_v joint of leg 2. A joint's columns carry the robot's name for it
+//! ([`crate::hexapod::LegJoints`], the description's `[joints] names`; AMRU5's are the thesis'
+//! q_r, q_v, q_h, used in the table below), their units its kind: rad, rad/s, Nm for a
+//! revolute joint, m, m/s, N for a prismatic one.
 //!
 //! | columns | unit | |
 //! | --- | --- | --- |
@@ -51,7 +54,7 @@ use super::recorder::Recorder;
 use super::simulation::SimulatedRobot;
 use crate::control::gait::schedule::GaitState;
 use crate::control::{Command, GroundExperimentState, Measurements};
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::JOINTS;
 
 /// The optional column groups of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -70,6 +73,7 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     let (q, qd) = (st.q.as_slice(), st.qd.as_slice());
     let out = &p.robot.outputs;
     let e = &p.energy;
+    let joints = &p.robot.model.joints;
     let s = |x: &str| x.to_string();
     rec.begin_row();
     rec.put(meas.t, || (s("t"), "s", s("control instant")));
@@ -80,10 +84,10 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
         let (n, u) = BODY_DOT[i];
         (s(n), u, format!("time derivative of {}", &n[..n.len() - 4]))
     });
-    rec.put_each(&q[6..6 + JOINTS], |k| (joint_name("", k, ""), joint_unit(k, ("rad", "m")), format!("joint position, leg {}", k / 3)));
-    rec.put_each(&qd[6..6 + JOINTS], |k| (joint_name("", k, "_dot"), joint_unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
+    rec.put_each(&q[6..6 + JOINTS], |k| (joints.column("", k, ""), joints.unit(k, ("rad", "m")), format!("joint position, leg {}", k / 3)));
+    rec.put_each(&qd[6..6 + JOINTS], |k| (joints.column("", k, "_dot"), joints.unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
     if groups.references {
-        rec.put_each(&cmd.references, |k| (joint_name("", k, "_ref"), joint_unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
+        rec.put_each(&cmd.references, |k| (joints.column("", k, "_ref"), joints.unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
     }
     if let Some(g) = gait {
         record_gait(rec, g);
@@ -91,13 +95,13 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     if let Some(g) = ground {
         record_ground_detection(rec, g);
     }
-    rec.put_each(&out.voltage, |k| (joint_name("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
-    rec.put_each(&out.current, |k| (joint_name("i_", k, ""), "A", s("motor current")));
-    rec.put_each(&meas.currents, |k| (joint_name("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
-    rec.put_each(&out.motor_torque, |k| (joint_name("tau_m_", k, ""), joint_unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
-    rec.put_each(&out.friction_torque, |k| (joint_name("tau_f_", k, ""), joint_unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
+    rec.put_each(&out.voltage, |k| (joints.column("u_", k, ""), "V", s("voltage across motor and H-bridge held over the period ending at t (after saturation and limit switches)")));
+    rec.put_each(&out.current, |k| (joints.column("i_", k, ""), "A", s("motor current")));
+    rec.put_each(&meas.currents, |k| (joints.column("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
+    rec.put_each(&out.motor_torque, |k| (joints.column("tau_m_", k, ""), joints.unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
+    rec.put_each(&out.friction_torque, |k| (joints.column("tau_f_", k, ""), joints.unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
     if groups.bristles {
-        rec.put_each(&out.bristle, |k| (joint_name("z_", k, ""), joint_unit(k, ("rad", "m")), s("LuGre bristle deflection")));
+        rec.put_each(&out.bristle, |k| (joints.column("z_", k, ""), joints.unit(k, ("rad", "m")), s("LuGre bristle deflection")));
     }
     for (f, c) in out.contact.iter().enumerate() {
         rec.put(c.force.x, || (format!("Fx[{f}]"), "N", s("ground force on the foot, x (global)")));
@@ -111,9 +115,9 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
         rec.put(x.y, || (format!("foot_y[{f}]"), "m", s("foot position y (global)")));
         rec.put(x.z, || (format!("foot_z[{f}]"), "m", s("foot position z (global)")));
     }
-    rec.put_each(&e.electrical, |k| (joint_name("E_el_", k, ""), "J", s("cumulative electrical energy drawn, integral of u i")));
-    rec.put_each(&e.joule, |k| (joint_name("E_joule_", k, ""), "J", s("cumulative Joule losses in motor and H-bridge")));
-    rec.put_each(&e.friction_work, |k| (joint_name("E_fric_", k, ""), "J", s("cumulative work against joint friction, integral of tau_f q'")));
+    rec.put_each(&e.electrical, |k| (joints.column("E_el_", k, ""), "J", s("cumulative electrical energy drawn, integral of u i")));
+    rec.put_each(&e.joule, |k| (joints.column("E_joule_", k, ""), "J", s("cumulative Joule losses in motor and H-bridge")));
+    rec.put_each(&e.friction_work, |k| (joints.column("E_fric_", k, ""), "J", s("cumulative work against joint friction, integral of tau_f q'")));
     rec.put(e.kinetic, || (s("E_kin"), "J", s("kinetic energy")));
     rec.put(e.potential, || (s("E_pot"), "J", s("gravitational potential energy")));
     rec.put(e.contact_work.iter().sum(), || (s("E_contact"), "J", s("cumulative work of the feet on the ground")));
@@ -172,16 +176,3 @@ pub fn record_ground_detection(rec: &mut Recorder, g: &GroundExperimentState) {
     rec.put(f64::from(u8::from(g.stop.is_some())), || (s("gd_stop"), "1", s("1: the tested leg stopped at this instant (a row of Table 5.7: the true force is Fn[gd_leg])")));
 }
 
-/// Unit of a joint quantity: (rotational, translational).
-fn joint_unit(k: usize, units: (&'static str, &'static str)) -> &'static str {
-    if Joint::ALL[k % 3].is_rotational() {
-        units.0
-    } else {
-        units.1
-    }
-}
-
-/// `q_v[2]` style name of joint k with a prefix and suffix: `{prefix}q_v{suffix}[2]`.
-fn joint_name(prefix: &str, k: usize, suffix: &str) -> String {
-    format!("{prefix}{}{suffix}[{}]", Joint::ALL[k % 3].symbol(), k / 3)
-}

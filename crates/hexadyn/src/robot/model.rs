@@ -17,7 +17,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, Vector3};
 
 use crate::description::{JointFrictionParameters, RobotDescription};
-use crate::hexapod::{joint_index, Joint, Mechanics, MechanicsParameters, DOF, JOINTS};
+use crate::hexapod::{joint_index, LegJoints, Mechanics, MechanicsParameters, PantographJoint, DOF, JOINTS};
 use crate::mbs::{self, Data};
 use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
@@ -114,6 +114,8 @@ impl ModelOptions {
 #[derive(Clone)]
 pub struct RobotModel {
     pub mechanics: Mechanics,
+    /// The names and kinds of a leg's joints: the layout's and the results' column names.
+    pub joints: LegJoints,
     /// Per joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
     pub motors: [DcMotor; JOINTS],
     pub friction: [FrictionElement; JOINTS],
@@ -130,7 +132,7 @@ pub struct RobotModel {
     pid: Option<usize>,
 }
 
-fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &ModelOptions) -> FrictionElement {
+fn friction_element(d: &RobotDescription, leg: usize, joint: PantographJoint, options: &ModelOptions) -> FrictionElement {
     // The description's parameters carry the thesis names of the laws' parameters.
     let parameters = d.friction(leg, joint);
     let JointFrictionParameters { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, load_dependence, .. } = parameters;
@@ -141,8 +143,8 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &Mo
             // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
             // (horizontal, viscous effects neglected).
             let (steady, f_v_plus, f_v_minus) = match (joint, q_st) {
-                (Joint::Vertical, Some(qd_st)) => (SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st }, f_v_plus, f_v_minus),
-                (Joint::Horizontal, _) => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, 0.0, 0.0),
+                (PantographJoint::Vertical, Some(qd_st)) => (SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st }, f_v_plus, f_v_minus),
+                (PantographJoint::Horizontal, _) => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, 0.0, 0.0),
                 _ => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, f_v_plus, f_v_minus),
             };
             JointFriction::LuGre(LuGre { sigma_0, sigma_1, v_d, f_v_plus, f_v_minus, steady })
@@ -158,7 +160,7 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: Joint, options: &Mo
 impl RobotModel {
     pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
-        let motor = |joint: Joint| DcMotor {
+        let motor = |joint: PantographJoint| DcMotor {
             r: d.motor.resistance_ohm,
             r_bridge: d.driver.series_resistance_ohm(),
             l: d.motor.inductance_h(),
@@ -166,9 +168,9 @@ impl RobotModel {
             n: d.reduction(joint),
             inductance: options.inductance,
         };
-        let motors = std::array::from_fn(|k| motor(Joint::ALL[k % 3]));
-        let friction = std::array::from_fn(|k| friction_element(d, k / 3, Joint::ALL[k % 3], &options));
-        let strokes = Joint::ALL.map(|j| {
+        let motors = std::array::from_fn(|k| motor(PantographJoint::ALL[k % 3]));
+        let friction = std::array::from_fn(|k| friction_element(d, k / 3, PantographJoint::ALL[k % 3], &options));
+        let strokes = PantographJoint::ALL.map(|j| {
             let (lo, hi) = d.joint_range(j);
             lo..=hi
         });
@@ -178,7 +180,8 @@ impl RobotModel {
         for (i, name) in names.iter().enumerate() {
             layout.push(*name, Order::Second, if i < 3 { 1e-6 } else { 1e-5 }, "multibody (main body)");
         }
-        let joint_name = |k: usize| format!("{}[{}]", Joint::ALL[k % 3].symbol(), k / 3);
+        let joints = d.joints.names.clone();
+        let joint_name = |k: usize| joints.column("", k, "");
         for k in 0..JOINTS {
             let scale = if k % 3 == 0 { 1e-5 } else { 1e-7 };
             layout.push(joint_name(k), Order::Second, scale, format!("multibody (leg {})", k / 3));
@@ -202,7 +205,7 @@ impl RobotModel {
         let pids = match options.control {
             JointControl::Digital => None,
             JointControl::ContinuousPid { t_d, n, omega_0 } => Some(std::array::from_fn(|k| {
-                let g = d.pi_gains(Joint::ALL[k % 3]);
+                let g = d.pi_gains(PantographJoint::ALL[k % 3]);
                 ContinuousPid { k: g.k, t_i: g.t_i, t_d, n, omega_0 }
             })),
         };
@@ -215,7 +218,7 @@ impl RobotModel {
             }
             first
         });
-        RobotModel { mechanics, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
+        RobotModel { mechanics, joints, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
     }
 
     /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance,

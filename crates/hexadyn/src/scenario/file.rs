@@ -14,11 +14,11 @@ use serde::Deserialize;
 use super::gait::{self, RawGait};
 use super::joint_friction::RawJointFriction;
 use super::terrain::{self, RawTerrain};
-use super::{joint_number, ControlMode, Initial, ModelFlags, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
+use super::{ControlMode, Initial, ModelFlags, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
 use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{RobotDescription, AMRU5_TOML};
 use crate::fields::{Ctx, DescriptionError};
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::{PantographJoint, JOINTS};
 use crate::physics::LOAD_GRAVITY;
 use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
@@ -167,16 +167,6 @@ struct RawControl {
     motion: Vec<RawMotion>,
 }
 
-#[derive(Clone, Copy, Deserialize)]
-enum RawJoint {
-    #[serde(rename = "q_r")]
-    Rotation,
-    #[serde(rename = "q_v")]
-    Vertical,
-    #[serde(rename = "q_h")]
-    Horizontal,
-}
-
 #[derive(Clone, Copy, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 enum MotionKind {
@@ -191,7 +181,8 @@ enum MotionKind {
 #[serde(deny_unknown_fields)]
 struct RawMotion {
     leg: i64,
-    joint: RawJoint,
+    /// One of the robot's joint names (`[joints] names`).
+    joint: String,
     kind: MotionKind,
     rate: Option<f64>,
     start_s: Option<f64>,
@@ -381,14 +372,14 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         }
     }
     let (q_r_deg, q_v_m, q_h_m, q_v_lifted_m) = (i.q_r_deg.unwrap_or(0.0), i.q_v_m.unwrap_or_else(default_q_v), i.q_h_m.unwrap_or_else(default_q_h), i.q_v_lifted_m.unwrap_or_else(default_q_v_lifted));
-    let range = |j: Joint| robot.joint_range(j);
+    let range = |j: PantographJoint| robot.joint_range(j);
     let stroke = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str, what: &str| {
         c.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}] {unit} ({what} of the robot description, joint_ranges)"))
     };
     let r = &robot.joint_ranges.q_r_deg;
     stroke("initial.q_r_deg", q_r_deg, (r.min, r.max), "deg", "the q_r range").map_err(e)?;
-    stroke("initial.q_v_m", q_v_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
-    stroke("initial.q_h_m", q_h_m, range(Joint::Horizontal), "m", "the q_h stroke").map_err(e)?;
+    stroke("initial.q_v_m", q_v_m, range(PantographJoint::Vertical), "m", "the q_v stroke").map_err(e)?;
+    stroke("initial.q_h_m", q_h_m, range(PantographJoint::Horizontal), "m", "the q_h stroke").map_err(e)?;
     let mut lifted = Vec::new();
     for (n, &leg) in i.lifted_legs.iter().flatten().enumerate() {
         let field = format!("initial.lifted_legs[{n}]");
@@ -403,7 +394,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
     lifted.sort_unstable();
     if !lifted.is_empty() {
-        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(Joint::Vertical), "m", "the q_v stroke").map_err(e)?;
+        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(PantographJoint::Vertical), "m", "the q_v stroke").map_err(e)?;
         if q_v_lifted_m >= q_v_m {
             return Err(e(c.err(
                 "initial.q_v_lifted_m",
@@ -452,7 +443,8 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     for (n, rm) in raw.control.motion.iter().enumerate() {
         let motion = validate_motion(rm, &format!("control.motion[{n}]"), c, &robot, &joints, h.duration_s).map_err(e)?;
         if !seen.insert(motion.joint_index()) {
-            return Err(e(c.err(&format!("control.motion[{n}].joint"), motion.joint.symbol(), &format!("a second motion of leg {}'s {}", motion.leg, motion.joint), "one motion per (leg, joint)")));
+            let name = robot.joints.names.name(motion.joint);
+            return Err(e(c.err(&format!("control.motion[{n}].joint"), name, &format!("a second motion of leg {}'s {name}", motion.leg), "one motion per (leg, joint)")));
         }
         motions.push(motion);
     }
@@ -494,15 +486,12 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
         return Err(c.err(&field("leg"), m.leg, "no such leg", "a leg number 0..5"));
     }
     let leg = m.leg as usize;
-    let joint = match m.joint {
-        RawJoint::Rotation => Joint::Rotation,
-        RawJoint::Vertical => Joint::Vertical,
-        RawJoint::Horizontal => Joint::Horizontal,
-    };
-    let base = joints[3 * leg + joint_number(joint)];
-    let (lo, hi) = robot.joint_range(joint);
+    let names = &robot.joints.names;
+    let joint = names.position(&m.joint).ok_or_else(|| c.err(&field("joint"), format!("{:?}", m.joint), "no such joint", format!("one of the robot's joints: {}", names.names().collect::<Vec<_>>().join(", "))))?;
+    let base = joints[3 * leg + joint];
+    let (lo, hi) = robot.joint_range(PantographJoint::ALL[joint]);
     let tol = STROKE_TOLERANCE * (hi - lo);
-    let unit = if joint.is_rotational() { "rad" } else { "m" };
+    let unit = names.kind(joint).unit(("rad", "m"));
     let (kind, used): (&str, &[&str]) = match m.kind {
         MotionKind::Ramp => ("ramp", &["rate", "start_s", "stop_s"]),
         MotionKind::Sine => ("sine", &["amplitude", "frequency_hz"]),
@@ -533,7 +522,7 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
         v.ok_or_else(|| c.err(&field(name), "<missing>", "missing field", format!("kind = \"{kind}\" needs {}", used.join(", "))))
     };
     let (lo_s, hi_s, base_s) = (short(lo), short(hi), short(base));
-    let stroke_text = format!("the {} stroke [{lo_s}, {hi_s}] {unit} (joint_ranges of the robot description; base {base_s} {unit})", joint.symbol());
+    let stroke_text = format!("the {} stroke [{lo_s}, {hi_s}] {unit} (joint_ranges of the robot description; base {base_s} {unit})", names.name(joint));
     let motion = match m.kind {
         MotionKind::Ramp => {
             let rate = required("rate", m.rate)?;
@@ -618,7 +607,7 @@ fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &RobotDescrip
     c.check(g.trials >= 1, "ground_detection.trials", g.trials as f64, "an integer >= 1")?;
     let period = robot.controller.period_s;
     c.check(g.period.is_finite() && g.period >= 4.0 * period, "ground_detection.period_s", g.period, &format!("a finite period >= {} s (four control periods)", 4.0 * period))?;
-    let (lo, hi) = robot.joint_range(Joint::Vertical);
+    let (lo, hi) = robot.joint_range(PantographJoint::Vertical);
     let tol = STROKE_TOLERANCE * (hi - lo);
     let room = g.legs.iter().map(|&l| initial.joints[3 * l + 1]).map(|q| (q - lo).min(hi - q)).fold(f64::INFINITY, f64::min);
     c.check(g.amplitude > 0.0 && g.amplitude <= room + tol, "ground_detection.amplitude_m", g.amplitude, &format!("a value in (0, {}] m, so that q_v ± amplitude stays in the q_v stroke [{}, {}] m around initial.q_v_m", short(room), short(lo), short(hi)))?;

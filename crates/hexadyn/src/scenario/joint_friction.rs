@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use crate::description::{Measured, PerLeg, RobotDescription};
 use crate::fields::{Ctx, DescriptionError};
-use crate::hexapod::Joint;
+use crate::hexapod::PantographJoint;
 
 /// The raw `[model.joint_friction]` table.
 #[derive(Deserialize, Default)]
@@ -63,7 +63,7 @@ impl Sign {
 impl RawJointFriction {
     /// Validates the table and writes its values into every leg of `robot`.
     pub(super) fn apply(&self, c: &Ctx, robot: &mut RobotDescription) -> Result<(), DescriptionError> {
-        for (joint, raw) in [(Joint::Rotation, &self.q_r), (Joint::Vertical, &self.q_v), (Joint::Horizontal, &self.q_h)] {
+        for (joint, raw) in [(PantographJoint::Rotation, &self.q_r), (PantographJoint::Vertical, &self.q_v), (PantographJoint::Horizontal, &self.q_h)] {
             if let Some(p) = raw {
                 p.apply(c, joint, robot)?;
             }
@@ -73,7 +73,7 @@ impl RawJointFriction {
 }
 
 impl RawJointParameters {
-    fn apply(&self, c: &Ctx, joint: Joint, robot: &mut RobotDescription) -> Result<(), DescriptionError> {
+    fn apply(&self, c: &Ctx, joint: PantographJoint, robot: &mut RobotDescription) -> Result<(), DescriptionError> {
         let path = format!("model.joint_friction.{}", joint.symbol());
         let field = |name: &str| format!("{path}.{name}");
         let (dry, viscous) = if joint.is_rotational() { ("Nm", "Nm s/rad") } else { ("N", "N s/m") };
@@ -88,7 +88,7 @@ impl RawJointParameters {
         let tau_f_d_minus = checked("tau_f_d_minus", self.tau_f_d_minus, Sign::NonPositive, &format!("dry friction tau_f_d^-, {dry}"))?;
         let f_v_minus = checked("f_v_minus", self.f_v_minus, Sign::NonNegative, &format!("viscous slope f_v^-, {viscous}"))?;
         let load = [("a_2_plus", self.a_2_plus, Sign::NonNegative, "a_2^+ of Eq. 5.12, N/kg^2"), ("a_1_plus", self.a_1_plus, Sign::NonNegative, "a_1^+ of Eq. 5.12, N/kg"), ("a_2_minus", self.a_2_minus, Sign::NonPositive, "a_2^- of Eq. 5.12, N/kg^2"), ("a_1_minus", self.a_1_minus, Sign::NonPositive, "a_1^- of Eq. 5.12, N/kg")];
-        if joint != Joint::Horizontal {
+        if joint != PantographJoint::Horizontal {
             if let Some((name, Some(v), _, _)) = load.iter().find(|l| l.1.is_some()) {
                 return Err(c.err(&field(name), v, "no load dependence on this joint", "the load coefficients a_* only in [model.joint_friction.q_h] (Eq. 5.12 holds for the horizontal joints)"));
             }
@@ -100,9 +100,9 @@ impl RawJointParameters {
 
         let f = &mut robot.friction;
         let tables: [&mut PerLeg; 4] = match joint {
-            Joint::Rotation => [&mut f.q_r.tau_f_d_plus_nm, &mut f.q_r.f_v_plus_nms, &mut f.q_r.tau_f_d_minus_nm, &mut f.q_r.f_v_minus_nms],
-            Joint::Vertical => [&mut f.q_v.tau_f_d_plus_n, &mut f.q_v.f_v_plus_ns_per_m, &mut f.q_v.tau_f_d_minus_n, &mut f.q_v.f_v_minus_ns_per_m],
-            Joint::Horizontal => [&mut f.q_h.tau_f_d_plus_n, &mut f.q_h.f_v_plus_ns_per_m, &mut f.q_h.tau_f_d_minus_n, &mut f.q_h.f_v_minus_ns_per_m],
+            PantographJoint::Rotation => [&mut f.q_r.tau_f_d_plus_nm, &mut f.q_r.f_v_plus_nms, &mut f.q_r.tau_f_d_minus_nm, &mut f.q_r.f_v_minus_nms],
+            PantographJoint::Vertical => [&mut f.q_v.tau_f_d_plus_n, &mut f.q_v.f_v_plus_ns_per_m, &mut f.q_v.tau_f_d_minus_n, &mut f.q_v.f_v_minus_ns_per_m],
+            PantographJoint::Horizontal => [&mut f.q_h.tau_f_d_plus_n, &mut f.q_h.f_v_plus_ns_per_m, &mut f.q_h.tau_f_d_minus_n, &mut f.q_h.f_v_minus_ns_per_m],
         };
         for (table, value) in tables.into_iter().zip([tau_f_d_plus, f_v_plus, tau_f_d_minus, f_v_minus]) {
             if let Some(v) = value {

@@ -45,7 +45,7 @@ use serde::Deserialize;
 use crate::control::{GroundExperiment, JointMotion};
 use crate::description::RobotDescription;
 use crate::fields::{struct_fields, Ctx, DescriptionError, FieldError, SpanIndex};
-use crate::hexapod::{Joint, JOINTS};
+use crate::hexapod::JOINTS;
 use crate::robot::model::{FrictionModel, ModelOptions};
 use crate::robot::simulation::PlantOptions;
 use crate::physics::Terrain;
@@ -66,7 +66,7 @@ pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
 pub use run::{run_scenario, run_scenario_chunked, run_scenario_until, Record, ScenarioResults};
-pub use summary::{specific_resistance, GaitSummary, Summary, SummaryValue};
+pub use summary::{per_joint_entries, specific_resistance, GaitSummary, Summary, SummaryValue};
 
 /// Name of the embedded default robot in `scenario.robot`.
 pub const DEFAULT_ROBOT: &str = "amru5";
@@ -169,7 +169,8 @@ impl ControlMode {
 /// Initial configuration (before settling), SI.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Initial {
-    /// Joint positions per joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+    /// Joint positions per joint k = 3 leg + j (j in the order of the robot's joints; AMRU5:
+    /// 0 q_r, 1 q_v, 2 q_h).
     pub joints: [f64; JOINTS],
     pub lifted_legs: Vec<usize>,
     /// Static equilibrium with the joints locked before the start (Section 6.2).
@@ -182,22 +183,15 @@ pub struct Initial {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Motion {
     pub leg: usize,
-    pub joint: Joint,
+    /// Which joint of the leg (0..3, in the order of the robot's [`crate::hexapod::LegJoints`]).
+    pub joint: usize,
     pub motion: JointMotion,
 }
 
 impl Motion {
     /// Joint index k = 3 leg + joint.
     pub fn joint_index(&self) -> usize {
-        3 * self.leg + joint_number(self.joint)
-    }
-}
-
-fn joint_number(j: Joint) -> usize {
-    match j {
-        Joint::Rotation => 0,
-        Joint::Vertical => 1,
-        Joint::Horizontal => 2,
+        3 * self.leg + self.joint
     }
 }
 

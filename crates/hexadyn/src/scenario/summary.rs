@@ -1,13 +1,15 @@
 //! The summary of a run: totals and diagnostics ([`Summary`], in gait mode with a
 //! [`GaitSummary`]), accumulated control instant by control instant while the scenario runs.
 
+use std::borrow::Cow;
+
 use super::gait::GaitScenario;
 use super::Scenario;
 use crate::control::gait::controller::GaitDiagnostics;
 use crate::control::gait::pattern::FootCycle;
 use crate::control::gait::schedule::GaitState;
 use crate::control::Command;
-use crate::hexapod::{Workspace, JOINTS};
+use crate::hexapod::{LegJoints, Workspace, JOINTS};
 use crate::robot::simulation::SimulatedRobot;
 
 /// One summary value.
@@ -53,8 +55,10 @@ pub struct Summary {
     pub robot_mass_kg: f64,
     /// Electrical energy E = sum of u i dt over the actuators (Eq. 6.7).
     pub energy_electrical_j: f64,
-    /// The same per joint type (q_r, q_v, q_h), summed over the legs.
+    /// The same per joint of a leg (q_r, q_v, q_h on AMRU5), summed over the legs.
     pub energy_electrical_by_joint_j: [f64; 3],
+    /// The robot's joint names and kinds: the names and units of the per-joint entries.
+    pub joints: LegJoints,
     /// E over the simulated time: the averaged power of the robot (W).
     pub average_power_w: f64,
     pub energy_joule_j: f64,
@@ -74,7 +78,7 @@ pub struct Summary {
     pub saturated_fraction: f64,
     /// Commands cut by a limit switch (joint at a stroke end, pushed further out).
     pub limit_switch_cuts: u64,
-    /// Largest |reference − q| per joint type (q_r rad, q_v m, q_h m), PI mode only.
+    /// Largest |reference − q| per joint of a leg (rad or m), PI mode only.
     pub max_tracking_error: Option<[f64; 3]>,
     /// Largest foot penetration into the ground.
     pub max_penetration_m: f64,
@@ -86,10 +90,11 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// The values in a fixed order, names with units as suffixes.
-    pub fn entries(&self) -> Vec<(&'static str, SummaryValue)> {
+    /// The values in a fixed order, names with units as suffixes; the per-joint entries carry
+    /// the robot's joint names (`energy_electrical_q_v_j`, `max_tracking_error_q_v_m` on AMRU5).
+    pub fn entries(&self) -> Vec<(Cow<'static, str>, SummaryValue)> {
         use SummaryValue::{Count, Number, Text};
-        let mut v = vec![
+        let mut v: Vec<(Cow<'static, str>, SummaryValue)> = vec![
             ("scenario", Text(self.scenario.clone())),
             ("friction", Text(self.friction.to_string())),
             ("control", Text(self.control.to_string())),
@@ -110,9 +115,12 @@ impl Summary {
             ("body_horizontal_drift_m", Number(self.body_horizontal_drift_m)),
             ("robot_mass_kg", Number(self.robot_mass_kg)),
             ("energy_electrical_j", Number(self.energy_electrical_j)),
-            ("energy_electrical_q_r_j", Number(self.energy_electrical_by_joint_j[0])),
-            ("energy_electrical_q_v_j", Number(self.energy_electrical_by_joint_j[1])),
-            ("energy_electrical_q_h_j", Number(self.energy_electrical_by_joint_j[2])),
+        ]
+        .into_iter()
+        .map(|(n, x)| (Cow::Borrowed(n), x))
+        .collect();
+        v.extend(per_joint_entries(&self.joints, "energy_electrical", self.energy_electrical_by_joint_j, ("j", "j")));
+        let rest = [
             ("average_power_w", Number(self.average_power_w)),
             ("energy_joule_j", Number(self.energy_joule_j)),
             ("energy_friction_j", Number(self.energy_friction_j)),
@@ -126,28 +134,27 @@ impl Summary {
             ("saturated_fraction", Number(self.saturated_fraction)),
             ("limit_switch_cuts", Count(self.limit_switch_cuts)),
         ];
-        if let Some([r, vv, hh]) = self.max_tracking_error {
-            v.push(("max_tracking_error_q_r_rad", Number(r)));
-            v.push(("max_tracking_error_q_v_m", Number(vv)));
-            v.push(("max_tracking_error_q_h_m", Number(hh)));
+        v.extend(rest.into_iter().map(|(n, x)| (Cow::Borrowed(n), x)));
+        if let Some(errors) = self.max_tracking_error {
+            v.extend(per_joint_entries(&self.joints, "max_tracking_error", errors, ("rad", "m")));
         }
-        v.push(("max_penetration_m", Number(self.max_penetration_m)));
-        v.push(("static_penetration_m", Number(self.static_penetration_m)));
+        v.push((Cow::Borrowed("max_penetration_m"), Number(self.max_penetration_m)));
+        v.push((Cow::Borrowed("static_penetration_m"), Number(self.static_penetration_m)));
         if let Some(g) = &self.gait {
-            v.push(("gait_pattern", Text(g.pattern.clone())));
-            v.push(("gait_cycle", Text(g.cycle.to_string())));
-            v.push(("gait_heading", Text(g.heading.to_string())));
-            v.push(("navigation", Text(g.navigation.to_string())));
-            v.push(("tracking_error_xy_max_m", Number(g.tracking_error_xy_max_m)));
-            v.push(("tracking_error_xy_final_m", Number(g.tracking_error_xy_final_m)));
-            v.push(("tracking_error_yaw_max_rad", Number(g.tracking_error_yaw_max_rad)));
-            v.push(("distance_walked_m", Number(g.distance_walked_m)));
-            v.push(("reference_distance_m", Number(g.reference_distance_m)));
-            v.push(("specific_resistance", Number(specific_resistance(self.energy_electrical_j, self.robot_mass_kg, g.distance_walked_m))));
-            v.push(("clamped_ik_references", Count(g.clamped_ik_references)));
-            v.push(("gait_switches", Count(g.gait_switches)));
-            v.push(("min_feet_on_ground", Count(g.min_feet_on_ground)));
-            v.push(("max_foot_reference_outside_workspace_m", Number(g.max_foot_reference_outside_workspace_m)));
+            v.push((Cow::Borrowed("gait_pattern"), Text(g.pattern.clone())));
+            v.push((Cow::Borrowed("gait_cycle"), Text(g.cycle.to_string())));
+            v.push((Cow::Borrowed("gait_heading"), Text(g.heading.to_string())));
+            v.push((Cow::Borrowed("navigation"), Text(g.navigation.to_string())));
+            v.push((Cow::Borrowed("tracking_error_xy_max_m"), Number(g.tracking_error_xy_max_m)));
+            v.push((Cow::Borrowed("tracking_error_xy_final_m"), Number(g.tracking_error_xy_final_m)));
+            v.push((Cow::Borrowed("tracking_error_yaw_max_rad"), Number(g.tracking_error_yaw_max_rad)));
+            v.push((Cow::Borrowed("distance_walked_m"), Number(g.distance_walked_m)));
+            v.push((Cow::Borrowed("reference_distance_m"), Number(g.reference_distance_m)));
+            v.push((Cow::Borrowed("specific_resistance"), Number(specific_resistance(self.energy_electrical_j, self.robot_mass_kg, g.distance_walked_m))));
+            v.push((Cow::Borrowed("clamped_ik_references"), Count(g.clamped_ik_references)));
+            v.push((Cow::Borrowed("gait_switches"), Count(g.gait_switches)));
+            v.push((Cow::Borrowed("min_feet_on_ground"), Count(g.min_feet_on_ground)));
+            v.push((Cow::Borrowed("max_foot_reference_outside_workspace_m"), Number(g.max_foot_reference_outside_workspace_m)));
         }
         v
     }
@@ -304,6 +311,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         robot_mass_kg: plant.robot.model.mechanics.model.total_mass(),
         energy_electrical_j: sum(&e.electrical),
         energy_electrical_by_joint_j: std::array::from_fn(|j| e.electrical.iter().skip(j).step_by(3).sum()),
+        joints: plant.robot.model.joints.clone(),
         average_power_w: if plant.state().t > 0.0 { sum(&e.electrical) / plant.state().t } else { 0.0 },
         energy_joule_j: sum(&e.joule),
         energy_friction_j: sum(&e.friction_work),
@@ -321,6 +329,12 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         static_penetration_m: s.model.ground.static_penetration(plant.robot.model.mechanics.model.total_mass() * crate::mbs::STANDARD_GRAVITY / 3.0),
         gait: None,
     }
+}
+
+/// The summary entries `{quantity}_{name}_{unit}` of a per-joint figure, one per joint of a
+/// leg in the robot's order, `units.0` for a revolute joint and `units.1` for a prismatic one.
+pub fn per_joint_entries(joints: &LegJoints, quantity: &str, values: [f64; 3], units: (&'static str, &'static str)) -> Vec<(Cow<'static, str>, SummaryValue)> {
+    (0..3).map(|j| (Cow::Owned(format!("{quantity}_{}_{}", joints.name(j), joints.kind(j).unit(units))), SummaryValue::Number(values[j]))).collect()
 }
 
 /// Gait figures of a run, accumulated row by row.

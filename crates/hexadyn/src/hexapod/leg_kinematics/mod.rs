@@ -46,7 +46,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 
 use super::mechanics::MechanicsParameters;
 use super::pantograph::PantographGeometry;
-use super::Joint;
+use super::PantographJoint;
 use crate::spatial::{rotation_about, Htm};
 
 mod inverse;
@@ -58,7 +58,7 @@ pub enum LegKinematicsError {
     #[error("leg {0} does not exist (legs 0..5)")]
     NoSuchLeg(usize),
     #[error("the range of {joint} is not a finite, non-empty interval: [{lower}, {upper}]")]
-    InvalidRange { joint: Joint, lower: f64, upper: f64 },
+    InvalidRange { joint: PantographJoint, lower: f64, upper: f64 },
     #[error("the pantograph does not close everywhere in the joint ranges (AD from {k_min:.4} to {k_max:.4} m, needs |l_1 - c| < AD < l_1 + c)")]
     LinkageOpen { k_min: f64, k_max: f64 },
     #[error("non-finite {0}")]
@@ -96,7 +96,7 @@ impl JointLimits {
     }
 
     fn validate(&self) -> Result<(), LegKinematicsError> {
-        for (i, joint) in Joint::ALL.into_iter().enumerate() {
+        for (i, joint) in PantographJoint::ALL.into_iter().enumerate() {
             let (lower, upper) = (self.lower[i], self.upper[i]);
             if !(lower.is_finite() && upper.is_finite() && lower < upper) {
                 return Err(LegKinematicsError::InvalidRange { joint, lower, upper });

@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 
 use crate::control::{GroundDetector, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
 use crate::description::RobotDescription;
-use crate::hexapod::{Joint, LegKinematicsError};
+use crate::hexapod::{PantographJoint, LegKinematicsError};
 
 /// Decides, at each control instant, which feet are on the ground, from the measurements. The
 /// free gait controller calls it once per update (so a detector may filter its signals over
@@ -100,7 +100,7 @@ impl MotorCurrent {
         Ok(MotorCurrent {
             detector: GroundDetector::new(d, dt, threshold)?,
             detections: Default::default(),
-            epsilon: std::array::from_fn(|l| d.friction(l, Joint::Vertical).dry_viscous().epsilon),
+            epsilon: std::array::from_fn(|l| d.friction(l, PantographJoint::Vertical).dry_viscous().epsilon),
             sliding: [0.0; 6],
             settling: SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ),
             dt,
@@ -155,8 +155,8 @@ mod tests {
         let h = 1e-7;
         let dz = (leg.foot(&(q + Vector3::new(0.0, h, 0.0))).z - leg.foot(&(q - Vector3::new(0.0, h, 0.0))).z) / (2.0 * h);
         let tau_gnd = -dz * f;
-        let friction = robot.friction(0, Joint::Vertical).dry_viscous().torque(qd_v).0;
-        (tau_gnd + friction) / robot.joint_torque_per_ampere(Joint::Vertical)
+        let friction = robot.friction(0, PantographJoint::Vertical).dry_viscous().torque(qd_v).0;
+        (tau_gnd + friction) / robot.joint_torque_per_ampere(PantographJoint::Vertical)
     }
 
     /// The leg going down (or up) for 2 s (six time constants of the 3 Hz filters) with the
