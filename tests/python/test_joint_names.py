@@ -102,3 +102,29 @@ def test_names_that_would_make_two_columns_one_are_refused(tmp_path, names, prob
         hexadyn.simulate("leg_sine", progress=False, overrides={"scenario.robot": str(robot)})
     message = str(error.value)
     assert "\n" not in message and str(robot) in message and "joints.names" in message and problem in message, message
+
+
+def test_monte_carlo_stores_the_split_per_joint_in_the_robots_order(tmp_path):
+    from hexadyn.montecarlo.execution import simulate_run
+    from hexadyn.montecarlo.storage import PER_JOINT_COLUMNS
+
+    scenario = shortened("validation_tripod_1_5cm", tmp_path, 2.0)
+    amru5 = simulate_run(str(scenario), {})
+    renamed = simulate_run(str(scenario), {"scenario.robot": str(renamed_robot(tmp_path))})
+    assert amru5["status"] == renamed["status"] == "ok", (amru5, renamed)
+    assert renamed["summary"] == amru5["summary"] | {"wall_time_s": renamed["summary"]["wall_time_s"]}
+    split = [renamed["summary"][c] for c in PER_JOINT_COLUMNS]
+    assert sum(split) == pytest.approx(renamed["summary"]["energy_electrical_j"], rel=1e-12)
+    assert min(split) > 0.0, split
+
+
+def test_the_viewer_reads_the_robots_joint_columns(pair, tmp_path):
+    from hexadyn import report
+    from hexadyn.view.data import Run
+
+    amru5, other = pair
+    report.save(other, tmp_path / "renamed")
+    run = Run(tmp_path / "renamed")
+    assert run.joints.names == RENAMED
+    np.testing.assert_array_equal(run.q[:, 6:9], other.timeseries[["slew[0]", "lift[0]", "reach[0]"]].to_numpy())
+    np.testing.assert_array_equal(run.q, amru5.timeseries[["X", "Y", "Z", "yaw", "pitch", "roll", *amru5.joints.actuators]].to_numpy())
