@@ -8,6 +8,7 @@ mod mbs;
 mod monte_carlo;
 mod scenario;
 mod schema;
+mod urdf;
 mod view;
 
 #[pymodule]
@@ -15,6 +16,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("STANDARD_GRAVITY", hexadyn::mbs::STANDARD_GRAVITY)?;
     m.add_class::<mbs::PyMultibody>()?;
+    m.add_class::<urdf::PyUrdfHexapod>()?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::scenario_model, m)?)?;

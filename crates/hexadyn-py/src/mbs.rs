@@ -9,7 +9,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
-#[pyclass(name = "Multibody", module = "hexadyn._core")]
+#[pyclass(subclass, name = "Multibody", module = "hexadyn._core")]
 pub struct PyMultibody {
     model: Model,
     data: Data,
@@ -65,6 +65,18 @@ fn elementary(body: usize, item: &Bound<'_, PyAny>) -> PyResult<Elementary> {
 }
 
 impl PyMultibody {
+    /// The Python object of a model built in the engine.
+    pub(crate) fn of(model: Model) -> Self {
+        let data = Data::new(&model);
+        PyMultibody { model, data }
+    }
+    pub(crate) fn model(&self) -> &Model {
+        &self.model
+    }
+    pub(crate) fn data(&self) -> &Data {
+        &self.data
+    }
+
     fn check(&self, name: &str, v: &[f64]) -> PyResult<()> {
         let n = self.model.coordinate_count();
         if v.len() != n {
@@ -75,7 +87,7 @@ impl PyMultibody {
         }
         Ok(())
     }
-    fn evaluate(&mut self, q: &[f64], qd: &[f64]) -> PyResult<()> {
+    pub(crate) fn evaluate(&mut self, q: &[f64], qd: &[f64]) -> PyResult<()> {
         self.check("q", q)?;
         self.check("qd", qd)?;
         mbs::kinematics(&self.model, &mut self.data, q, qd);
@@ -107,9 +119,7 @@ impl PyMultibody {
             };
             b.add_body(spec).map_err(|e| err(i, e))?;
         }
-        let model = b.build();
-        let data = Data::new(&model);
-        Ok(PyMultibody { model, data })
+        Ok(PyMultibody::of(b.build()))
     }
 
     #[getter]

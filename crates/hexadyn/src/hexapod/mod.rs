@@ -1,6 +1,6 @@
 //! The hexapod's vocabulary and geometry, below both the controller and the simulated robot:
 //! the legs and the names and kinds of their three actuated joints (Eq. 3.51, [`LegJoints`]),
-//! the pantograph linkage of a leg
+//! serial legs given the URDF way ([`SerialHexapod`]), the pantograph linkage of a leg
 //! (Section 3.4.1, Eq. 3.57-3.63), the multibody assembly of the whole hexapod (Eq. 3.51-3.71),
 //! the leg kinematics (Section 7.3) and the leg workspace (Section 7.1.1).
 //!
@@ -18,6 +18,7 @@ pub mod leg_dynamics;
 pub mod leg_kinematics;
 pub mod mechanics;
 pub mod pantograph;
+pub mod serial;
 pub mod workspace;
 
 pub use joints::{JointKind, JointNameError, LegJoints};
@@ -25,6 +26,7 @@ pub use leg_dynamics::{joint_torques, leg_joint_torques, StillBody};
 pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegKinematics, LegKinematicsError, Limit};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::{PantographGeometry, PantographJoint};
+pub use serial::{Link, SerialHexapod, SerialJoint, SerialLeg, SerialMechanics};
 pub use workspace::Workspace;
 
 /// Number of legs of a hexapod; every per-leg array has this length.
