@@ -37,6 +37,15 @@ pub struct UrdfError {
     pub allowed: String,
 }
 
+impl UrdfError {
+    /// The error with every control character of the file's text (a name with a line break)
+    /// escaped, so that it stays one line.
+    fn new(file: &str, element: impl Into<String>, problem: impl Into<String>, allowed: impl Into<String>) -> Self {
+        let line = |s: String| if s.chars().any(char::is_control) { s.chars().flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] }).collect() } else { s };
+        UrdfError { file: line(file.to_string()), element: line(element.into()), problem: line(problem.into()), allowed: allowed.into() }
+    }
+}
+
 /// The pose of a URDF `<origin xyz rpy>`: R = R_z(yaw) R_y(pitch) R_x(roll) (Eq. 3.52's order).
 fn pose(p: &urdf_rs::Pose) -> Htm {
     let [roll, pitch, yaw] = p.rpy.0;
@@ -70,7 +79,7 @@ struct Reader<'a> {
 
 impl<'a> Reader<'a> {
     fn err(&self, element: impl Into<String>, problem: impl Into<String>, allowed: impl Into<String>) -> UrdfError {
-        UrdfError { file: self.file.to_string(), element: element.into(), problem: problem.into(), allowed: allowed.into() }
+        UrdfError::new(self.file, element, problem, allowed)
     }
 
     /// The link `name` and everything fixed to it.
@@ -108,11 +117,11 @@ impl<'a> Reader<'a> {
         if !(m.is_finite() && m > 0.0) {
             return Err(self.err(element, format!("mass {m} kg (a missing <inertial> is a zero mass)"), "a positive mass in <inertial>"));
         }
-        let moments = SymmetricEigen::new(*i).eigenvalues;
-        let scale = moments.abs().max();
-        let tol = 1e-9 * scale;
+        // Bounded iterations: a tensor of overflowing entries gives no decomposition, not a hang.
+        let moments = SymmetricEigen::try_new(*i, f64::EPSILON, 1000).map_or(Vector3::repeat(f64::NAN), |e| e.eigenvalues);
+        let tol = 1e-9 * moments.abs().max();
         let triangle = (0..3).all(|k| moments[k] <= moments[(k + 1) % 3] + moments[(k + 2) % 3] + tol);
-        if !(i.iter().all(|x| x.is_finite()) && moments.min() > 0.0 && triangle) {
+        if !(moments.iter().all(|m| m.is_finite()) && moments.min() > 0.0 && triangle) {
             return Err(self.err(element, format!("inertia with principal moments ({:.4e}, {:.4e}, {:.4e}) kg m²", moments[0], moments[1], moments[2]), "a positive definite tensor whose principal moments satisfy the triangle inequality"));
         }
         Ok(())
@@ -122,7 +131,7 @@ impl<'a> Reader<'a> {
     fn joint(&self, j: &urdf_rs::Joint, origin: Htm) -> Result<SerialJoint, UrdfError> {
         let element = format!("joint \"{}\"", j.name);
         let axis = Vector3::from(j.axis.xyz.0);
-        if !(axis.iter().all(|x| x.is_finite()) && axis.norm() > 1e-12) {
+        if !(axis.iter().all(|x| x.is_finite()) && axis.amax() > 1e-12) {
             return Err(self.err(element, format!("axis ({} {} {})", axis.x, axis.y, axis.z), "a non-zero finite axis"));
         }
         let (lower, upper) = (j.limit.lower, j.limit.upper);
@@ -130,7 +139,9 @@ impl<'a> Reader<'a> {
             return Err(self.err(element, format!("limits [{lower}, {upper}]"), "a <limit> with finite lower < upper (the workspace is computed from the ranges)"));
         }
         let kind = if j.joint_type == urdf_rs::JointType::Prismatic { JointKind::Prismatic } else { JointKind::Revolute };
-        Ok(SerialJoint { name: j.name.clone(), origin, axis: axis.normalize(), kind, lower, upper })
+        // Scaled before normalizing, so that an axis of huge components does not overflow.
+        let axis = (axis / axis.amax()).normalize();
+        Ok(SerialJoint { name: j.name.clone(), origin, axis, kind, lower, upper })
     }
 
     /// The leg that starts with the actuated joint `first` leaving the base.
@@ -171,14 +182,17 @@ impl<'a> Reader<'a> {
 
 /// Reads a serial hexapod from URDF `text`; `file` names it in errors.
 pub fn serial_hexapod_from_urdf(text: &str, file: &str) -> Result<SerialHexapod, UrdfError> {
-    let one_line = |e: &dyn std::fmt::Display| e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
-    let robot = urdf_rs::read_from_string(text).map_err(|e| UrdfError { file: file.to_string(), element: "robot".into(), problem: format!("not a URDF robot ({})", one_line(&e)), allowed: "a <robot> of <link> and <joint> elements (URDF)".into() })?;
+    let robot = urdf_rs::read_from_string(text).map_err(|e| {
+        let reason = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+        UrdfError::new(file, "robot", format!("not a URDF robot ({reason})"), "a <robot> of <link> and <joint> elements (URDF)")
+    })?;
     let mut r = Reader { file, links: HashMap::new(), children: HashMap::new() };
     for l in &robot.links {
         if r.links.insert(l.name.as_str(), l).is_some() {
             return Err(r.err(format!("link \"{}\"", l.name), "defined twice", "one <link> per name"));
         }
     }
+    check_numbers(&r, &robot)?;
     let mut parent_of: HashMap<&str, &str> = HashMap::new();
     for j in &robot.joints {
         let element = format!("joint \"{}\"", j.name);
@@ -234,6 +248,36 @@ pub fn serial_hexapod_from_urdf(text: &str, file: &str) -> Result<SerialHexapod,
         }
     }
     Ok(SerialHexapod { name: robot.name.clone(), base: base.inertia, legs: legs.try_into().map_err(|_| r.err("robot", "not six legs", "six legs"))? })
+}
+
+/// Every number the model uses is finite (and a sphere's radius positive), so that nothing
+/// downstream meets a NaN.
+fn check_numbers(r: &Reader, robot: &urdf_rs::Robot) -> Result<(), UrdfError> {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    let pose_ok = |p: &urdf_rs::Pose| finite(&p.xyz.0) && finite(&p.rpy.0);
+    for l in &robot.links {
+        let element = format!("link \"{}\"", l.name);
+        let i = &l.inertial;
+        let inertia = [i.mass.value, i.inertia.ixx, i.inertia.ixy, i.inertia.ixz, i.inertia.iyy, i.inertia.iyz, i.inertia.izz];
+        if !(pose_ok(&i.origin) && finite(&inertia)) {
+            return Err(r.err(element, "a non-finite number in <inertial>", "finite origin, mass and inertia"));
+        }
+        for c in &l.collision {
+            let radius_ok = match c.geometry {
+                urdf_rs::Geometry::Sphere { radius } => radius.is_finite() && radius > 0.0,
+                _ => true,
+            };
+            if !(pose_ok(&c.origin) && radius_ok) {
+                return Err(r.err(element, "a <collision> with a non-finite origin or a sphere radius that is not positive", "finite origins, spheres of positive radius"));
+            }
+        }
+    }
+    for j in &robot.joints {
+        if !pose_ok(&j.origin) {
+            return Err(r.err(format!("joint \"{}\"", j.name), "a non-finite number in <origin>", "finite xyz and rpy"));
+        }
+    }
+    Ok(())
 }
 
 /// Sorts the legs into the thesis numbering: the left ones (y > 0 at the first joint) 0, 2, 4
