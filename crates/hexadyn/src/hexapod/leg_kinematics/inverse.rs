@@ -9,9 +9,58 @@
 //! linkage can reach the target with the ranges ignored, how far beyond the ranges that
 //! would be. The joints returned are always finite and within the ranges.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
-use super::{LegKinematics, LegKinematicsError, RzMinus};
+use super::{JointLimits, LegKinematics, LegKinematicsError, RzMinus};
+
+/// What the inverse kinematics of Eq. 7.7 needs of a leg mechanism, whatever it is (the
+/// pantograph, a serial chain): k(q) and J(q) in the leg frame, the joint ranges and the
+/// iteration settings.
+pub trait LegChain {
+    /// k(q) and J(q) = ∂k/∂q (Eq. 7.6, 7.8).
+    fn foot_and_jacobian(&self, q: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>);
+    fn limits(&self) -> &JointLimits;
+    fn ik_options(&self) -> &IkOptions;
+    /// Whether the mechanism is assembled at q, ranges ignored (the pantograph's triangle
+    /// A-B-D closes); a serial chain always is.
+    fn assembles(&self, _q: &Vector3<f64>) -> bool {
+        true
+    }
+    /// A start for the closest-point search: q0 with the joints that aim the foot at the
+    /// target set (the pantograph turns q_r to the target's azimuth); none by default.
+    fn aimed(&self, _target: &Vector3<f64>, _q0: &Vector3<f64>, _foot: &Vector3<f64>) -> Option<(usize, f64)> {
+        None
+    }
+    fn foot(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        self.foot_and_jacobian(q).0
+    }
+    /// Further starts of Eq. 7.7 when the one given ends away from the target: a mechanism
+    /// with several branches (a serial leg's knee up or down) can put a local minimum of
+    /// |k(q) − p*| between the current joints and a reachable target. None by default.
+    fn seeds(&self) -> Vec<Vector3<f64>> {
+        Vec::new()
+    }
+}
+
+impl LegChain for LegKinematics {
+    fn foot_and_jacobian(&self, q: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+        LegKinematics::foot_and_jacobian(self, q)
+    }
+    fn limits(&self) -> &JointLimits {
+        &self.limits
+    }
+    fn ik_options(&self) -> &IkOptions {
+        &self.options
+    }
+    fn assembles(&self, q: &Vector3<f64>) -> bool {
+        self.pantograph.closes(q[1], q[2])
+    }
+    /// q_r aimed at the target's azimuth: the foot's azimuth is −q_r + atan2(s_y, s_x).
+    fn aimed(&self, target: &Vector3<f64>, q0: &Vector3<f64>, foot: &Vector3<f64>) -> Option<(usize, f64)> {
+        let s = RzMinus::new(-q0[0]).apply(foot);
+        (target.xy().norm() > 1e-9).then(|| (0, (s.y.atan2(s.x) - target.y.atan2(target.x)).clamp(self.limits.lower[0], self.limits.upper[0])))
+    }
+}
 
 /// Settings of the Newton-Raphson iteration of Eq. 7.7.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,172 +143,192 @@ impl LegKinematics {
         self.inverse(&self.to_leg(target_body), start)
     }
 
-    /// Joints q* with k(q*) = p* (leg frame) by Newton-Raphson (Eq. 7.7) from `start`
-    /// (normally the current joints; projected into the ranges first).
-    ///
-    /// Every iterate is projected into the joint ranges. When the iteration cannot reach the
-    /// tolerance (the target is out of the reachable set), the closest foot position within
-    /// the ranges is searched and the solution is [`IkOutcome::Clamped`]. Only non-finite
-    /// inputs are errors.
+    /// [`inverse`] of this leg.
     pub fn inverse(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
-        if !target.iter().all(|v| v.is_finite()) {
-            return Err(LegKinematicsError::NonFinite("inverse-kinematics target"));
+        inverse(self, target, start)
+    }
+}
+
+/// Joints q* with k(q*) = p* (leg frame) by Newton-Raphson (Eq. 7.7) from `start`
+/// (normally the current joints; projected into the ranges first).
+///
+/// Every iterate is projected into the joint ranges. When the iteration cannot reach the
+/// tolerance (the target is out of the reachable set), the closest foot position within
+/// the ranges is searched and the solution is [`IkOutcome::Clamped`]. Only non-finite
+/// inputs are errors.
+pub fn inverse<L: LegChain + ?Sized>(leg: &L, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
+    if !target.iter().all(|v| v.is_finite()) {
+        return Err(LegKinematicsError::NonFinite("inverse-kinematics target"));
+    }
+    if !start.iter().all(|v| v.is_finite()) {
+        return Err(LegKinematicsError::NonFinite("inverse-kinematics start"));
+    }
+    let limits = leg.limits();
+    let tol = leg.ik_options().tolerance;
+    let (q, p, e, mut iterations) = newton(leg, target, start);
+    if e <= tol {
+        return Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Reached });
+    }
+    // Out of reach (or slow): the closest point within the joint box.
+    let (q, p, extra) = closest(leg, target, &q);
+    iterations += extra;
+    let error = p - target;
+    let distance = error.norm();
+    if distance <= tol {
+        return Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Reached });
+    }
+    for seed in leg.seeds() {
+        let (q, p, n) = gauss_newton(leg, target, seed, [true; 3]);
+        iterations += n;
+        if (p - target).norm() <= tol {
+            return Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Reached });
         }
-        if !start.iter().all(|v| v.is_finite()) {
-            return Err(LegKinematicsError::NonFinite("inverse-kinematics start"));
+    }
+    let at_limits = std::array::from_fn(|i| {
+        if q[i] <= limits.lower[i] {
+            Limit::Lower
+        } else if q[i] >= limits.upper[i] {
+            Limit::Upper
+        } else {
+            Limit::Free
         }
-        let tol = self.options.tolerance;
-        let mut q = self.limits.clamp(start);
-        let (mut p, mut j) = self.foot_and_jacobian(&q);
-        let mut e = (p - target).norm();
-        let mut iterations = 0;
-        // Eq. 7.7: q^k = q^{k−1} − J^{-1} (k(q^{k−1}) − p*), projected into the ranges.
-        while e > tol && iterations < self.options.max_iterations {
-            let Some(dq) = j.lu().solve(&(p - target)) else { break };
-            let q_new = self.limits.clamp(&(q - dq));
-            iterations += 1;
-            let (p_new, j_new) = self.foot_and_jacobian(&q_new);
+    });
+    let excess = unconstrained(leg, target, &q).map(|qu| qu - q);
+    Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Clamped(Clamping { distance, error, limits: at_limits, excess }) })
+}
+
+/// Eq. 7.7 from `start`: q^k = q^{k−1} − J^{-1} (k(q^{k−1}) − p*), each iterate projected into
+/// the ranges, until the tolerance, no progress (the projection stalls on a limit: the target
+/// is out of reach) or the iteration budget. Returns (q, k(q), |k(q) − p*|, iterations).
+fn newton<L: LegChain + ?Sized>(leg: &L, target: &Vector3<f64>, start: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, f64, usize) {
+    let (limits, options) = (leg.limits(), leg.ik_options());
+    let mut q = limits.clamp(start);
+    let (mut p, mut j) = leg.foot_and_jacobian(&q);
+    let mut e = (p - target).norm();
+    let mut iterations = 0;
+    while e > options.tolerance && iterations < options.max_iterations {
+        let Some(dq) = j.lu().solve(&(p - target)) else { break };
+        let q_new = limits.clamp(&(q - dq));
+        iterations += 1;
+        let (p_new, j_new) = leg.foot_and_jacobian(&q_new);
+        let e_new = (p_new - target).norm();
+        if !(e_new < e) {
+            break;
+        }
+        (q, p, j, e) = (q_new, p_new, j_new, e_new);
+    }
+    (q, p, e, iterations)
+}
+
+/// min |k(q) − p*| over the joint box: projected Gauss-Newton on the interior and on every
+/// face, edge and corner of the box (26 + 1 sub-problems of at most 3 unknowns); the
+/// minimizer is the best of them. Returns (q, k(q), Gauss-Newton updates).
+fn closest<L: LegChain + ?Sized>(leg: &L, target: &Vector3<f64>, q0: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, usize) {
+    let limits = leg.limits();
+    let mut best = (*q0, leg.foot(q0));
+    let mut best_e = (best.1 - target).norm();
+    let mut updates = 0;
+    let aimed = leg.aimed(target, q0, &best.1);
+    for code in 0..27usize {
+        // Each joint: 0 free, 1 at lower, 2 at upper; code 0 is the interior problem.
+        let mask = [code % 3, (code / 3) % 3, code / 9];
+        let mut q = *q0;
+        for i in 0..3 {
+            match mask[i] {
+                1 => q[i] = limits.lower[i],
+                2 => q[i] = limits.upper[i],
+                _ => {}
+            }
+        }
+        if let Some((i, value)) = aimed.filter(|(i, _)| mask[*i] == 0) {
+            q[i] = value;
+        }
+        let (q, p, n) = gauss_newton(leg, target, q, mask.map(|m| m == 0));
+        updates += n;
+        let e = (p - target).norm();
+        if e < best_e {
+            (best, best_e) = ((q, p), e);
+        }
+    }
+    (best.0, best.1, updates)
+}
+
+/// Projected Gauss-Newton with backtracking on the `free` joints.
+fn gauss_newton<L: LegChain + ?Sized>(leg: &L, target: &Vector3<f64>, mut q: Vector3<f64>, free: [bool; 3]) -> (Vector3<f64>, Vector3<f64>, usize) {
+    let (mut p, mut j) = leg.foot_and_jacobian(&q);
+    let mut e = (p - target).norm();
+    let mut updates = 0;
+    if !free.iter().any(|&f| f) {
+        return (q, p, 0);
+    }
+    for _ in 0..50 {
+        if e <= leg.ik_options().tolerance {
+            break;
+        }
+        let r = p - target;
+        let mut jtj = j.transpose() * j;
+        let mut g = j.transpose() * r;
+        for i in 0..3 {
+            if !free[i] {
+                jtj.row_mut(i).fill(0.0);
+                jtj.column_mut(i).fill(0.0);
+                jtj[(i, i)] = 1.0;
+                g[i] = 0.0;
+            }
+        }
+        let Some(step) = jtj.lu().solve(&g) else { break };
+        let mut t = 1.0;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let q_new = leg.limits().clamp(&(q - step * t));
+            let (p_new, j_new) = leg.foot_and_jacobian(&q_new);
             let e_new = (p_new - target).norm();
-            if !(e_new < e) {
-                break; // no progress: the projection stalls on a limit (target out of reach)
-            }
-            (q, p, j, e) = (q_new, p_new, j_new, e_new);
-        }
-        if e <= tol {
-            return Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Reached });
-        }
-        // Out of reach (or slow): the closest point within the joint box.
-        let (q, p, extra) = self.closest(target, &q);
-        iterations += extra;
-        let error = p - target;
-        let distance = error.norm();
-        if distance <= tol {
-            return Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Reached });
-        }
-        let limits = std::array::from_fn(|i| {
-            if q[i] <= self.limits.lower[i] {
-                Limit::Lower
-            } else if q[i] >= self.limits.upper[i] {
-                Limit::Upper
-            } else {
-                Limit::Free
-            }
-        });
-        let excess = self.unconstrained(target, &q).map(|qu| qu - q);
-        Ok(IkSolution { joints: q, foot: p, iterations, outcome: IkOutcome::Clamped(Clamping { distance, error, limits, excess }) })
-    }
-
-    /// min |k(q) − p*| over the joint box: projected Gauss-Newton on the interior and on every
-    /// face, edge and corner of the box (26 + 1 sub-problems of at most 3 unknowns); the
-    /// minimizer is the best of them. Returns (q, k(q), Gauss-Newton updates).
-    fn closest(&self, target: &Vector3<f64>, q0: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, usize) {
-        let mut best = (*q0, self.foot(q0));
-        let mut best_e = (best.1 - target).norm();
-        let mut updates = 0;
-        // Azimuth of the target for q_r: azimuth of the foot is −q_r + atan2(s_y, s_x).
-        let s = RzMinus::new(-q0[0]).apply(&best.1);
-        let q_r_aim = (s.y.atan2(s.x) - target.y.atan2(target.x)).clamp(self.limits.lower[0], self.limits.upper[0]);
-        let aim = target.xy().norm() > 1e-9;
-        for code in 0..27usize {
-            // Each joint: 0 free, 1 at lower, 2 at upper; code 0 is the interior problem.
-            let mask = [code % 3, (code / 3) % 3, code / 9];
-            let mut q = *q0;
-            for i in 0..3 {
-                match mask[i] {
-                    1 => q[i] = self.limits.lower[i],
-                    2 => q[i] = self.limits.upper[i],
-                    _ => {}
-                }
-            }
-            if mask[0] == 0 && aim {
-                q[0] = q_r_aim;
-            }
-            let (q, p, n) = self.gauss_newton(target, q, mask.map(|m| m == 0));
-            updates += n;
-            let e = (p - target).norm();
-            if e < best_e {
-                (best, best_e) = ((q, p), e);
-            }
-        }
-        (best.0, best.1, updates)
-    }
-
-    /// Projected Gauss-Newton with backtracking on the `free` joints.
-    fn gauss_newton(&self, target: &Vector3<f64>, mut q: Vector3<f64>, free: [bool; 3]) -> (Vector3<f64>, Vector3<f64>, usize) {
-        let (mut p, mut j) = self.foot_and_jacobian(&q);
-        let mut e = (p - target).norm();
-        let mut updates = 0;
-        if !free.iter().any(|&f| f) {
-            return (q, p, 0);
-        }
-        for _ in 0..50 {
-            if e <= self.options.tolerance {
+            if e_new < e {
+                accepted = Some((q_new, p_new, j_new, e_new));
                 break;
             }
-            let r = p - target;
-            let mut jtj = j.transpose() * j;
-            let mut g = j.transpose() * r;
-            for i in 0..3 {
-                if !free[i] {
-                    jtj.row_mut(i).fill(0.0);
-                    jtj.column_mut(i).fill(0.0);
-                    jtj[(i, i)] = 1.0;
-                    g[i] = 0.0;
-                }
-            }
-            let Some(step) = jtj.lu().solve(&g) else { break };
-            let mut t = 1.0;
-            let mut accepted = None;
-            for _ in 0..40 {
-                let q_new = self.limits.clamp(&(q - step * t));
-                let (p_new, j_new) = self.foot_and_jacobian(&q_new);
+            t *= 0.5;
+        }
+        let Some((q_new, p_new, j_new, e_new)) = accepted else { break };
+        updates += 1;
+        let progress = e - e_new;
+        (q, p, j, e) = (q_new, p_new, j_new, e_new);
+        if progress <= 1e-15 * (1.0 + e) {
+            break;
+        }
+    }
+    (q, p, updates)
+}
+
+/// Newton-Raphson without the joint ranges, from the clamped solution, as long as the
+/// mechanism assembles ([`LegChain::assembles`]); `None` when it does not converge there.
+fn unconstrained<L: LegChain + ?Sized>(leg: &L, target: &Vector3<f64>, q0: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let tol = leg.ik_options().tolerance;
+    let mut q = *q0;
+    let (mut p, mut j) = leg.foot_and_jacobian(&q);
+    let mut e = (p - target).norm();
+    for _ in 0..50 {
+        if e <= tol {
+            return Some(q);
+        }
+        let dq = j.lu().solve(&(p - target))?;
+        let mut t = 1.0;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let q_new = q - dq * t;
+            if q_new.iter().all(|v| v.is_finite()) && leg.assembles(&q_new) {
+                let (p_new, j_new) = leg.foot_and_jacobian(&q_new);
                 let e_new = (p_new - target).norm();
                 if e_new < e {
                     accepted = Some((q_new, p_new, j_new, e_new));
                     break;
                 }
-                t *= 0.5;
             }
-            let Some((q_new, p_new, j_new, e_new)) = accepted else { break };
-            updates += 1;
-            let progress = e - e_new;
-            (q, p, j, e) = (q_new, p_new, j_new, e_new);
-            if progress <= 1e-15 * (1.0 + e) {
-                break;
-            }
+            t *= 0.5;
         }
-        (q, p, updates)
+        (q, p, j, e) = accepted?;
     }
-
-    /// Newton-Raphson without the joint ranges, from the clamped solution, as long as the
-    /// triangle A-B-D closes; `None` when it does not converge there.
-    fn unconstrained(&self, target: &Vector3<f64>, q0: &Vector3<f64>) -> Option<Vector3<f64>> {
-        let mut q = *q0;
-        let (mut p, mut j) = self.foot_and_jacobian(&q);
-        let mut e = (p - target).norm();
-        for _ in 0..50 {
-            if e <= self.options.tolerance {
-                return Some(q);
-            }
-            let dq = j.lu().solve(&(p - target))?;
-            let mut t = 1.0;
-            let mut accepted = None;
-            for _ in 0..40 {
-                let q_new = q - dq * t;
-                if q_new.iter().all(|v| v.is_finite()) && self.pantograph.closes(q_new[1], q_new[2]) {
-                    let (p_new, j_new) = self.foot_and_jacobian(&q_new);
-                    let e_new = (p_new - target).norm();
-                    if e_new < e {
-                        accepted = Some((q_new, p_new, j_new, e_new));
-                        break;
-                    }
-                }
-                t *= 0.5;
-            }
-            (q, p, j, e) = accepted?;
-        }
-        (e <= self.options.tolerance).then_some(q)
-    }
+    (e <= tol).then_some(q)
 }
 
 #[cfg(test)]

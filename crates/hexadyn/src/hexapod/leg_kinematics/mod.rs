@@ -50,7 +50,9 @@ use super::PantographJoint;
 use crate::spatial::{rotation_about, Htm};
 
 mod inverse;
-pub use inverse::{Clamping, IkOptions, IkOutcome, IkSolution, Limit};
+mod serial;
+pub use inverse::{inverse, Clamping, IkOptions, IkOutcome, IkSolution, LegChain, Limit};
+pub use serial::SerialLegKinematics;
 
 /// Errors of the leg kinematics: an unusable geometry or non-finite inputs.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -95,7 +97,7 @@ impl JointLimits {
         (self.lower + self.upper) / 2.0
     }
 
-    fn validate(&self) -> Result<(), LegKinematicsError> {
+    pub(super) fn validate(&self) -> Result<(), LegKinematicsError> {
         for (i, joint) in PantographJoint::ALL.into_iter().enumerate() {
             let (lower, upper) = (self.lower[i], self.upper[i]);
             if !(lower.is_finite() && upper.is_finite() && lower < upper) {
