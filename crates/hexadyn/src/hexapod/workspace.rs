@@ -183,12 +183,18 @@ fn bisect(h: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, mut ha: f64) -> f64 {
 /// max of f over [a, b]: the best of n + 1 samples, refined by golden-section search in the
 /// bracket around it.
 fn maximize(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+    argmax(f, a, b, n).1
+}
+
+/// [`maximize`] with the argument: (x, f(x)) of the best value met.
+pub(super) fn argmax(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64, f64) {
     let x = |i: usize| a + (b - a) * i as f64 / n as f64;
     let (mut i_best, mut best) = (0, f(a));
+    let mut x_best = a;
     for i in 1..=n {
         let v = f(x(i));
         if v > best {
-            (i_best, best) = (i, v);
+            (i_best, best, x_best) = (i, v, x(i));
         }
     }
     let (mut lo, mut hi) = (x(i_best.saturating_sub(1)), x((i_best + 1).min(n)));
@@ -209,7 +215,9 @@ fn maximize(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
             fd = f(d);
         }
     }
-    best.max(fc).max(fd)
+    let value = best.max(fc).max(fd);
+    let at = [(x_best, best), (c, fc), (d, fd)].into_iter().find(|&(_, v)| v == value).map_or(x_best, |(x, _)| x);
+    (at, value)
 }
 
 /// The workspace of a leg (Fig. 7.3): a vertical cylinder in the leg frame, of centre C =

@@ -19,6 +19,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::inverse::{inverse, IkOptions, IkSolution, LegChain};
 use super::{JointLimits, LegKinematicsError};
+use crate::hexapod::workspace::{argmax, Workspace};
 use crate::hexapod::{JointKind, SerialLeg};
 use crate::spatial::{rotation_about, Htm};
 
@@ -120,6 +121,95 @@ impl SerialLegKinematics {
     /// Inverse kinematics of a target given in the body frame.
     pub fn inverse_in_body(&self, target_body: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
         self.inverse(&self.to_leg(target_body), start)
+    }
+}
+
+/// Directions and heights at which the workspace's radius is measured.
+const DIRECTIONS: usize = 16;
+const HEIGHTS: usize = 3;
+/// March step (m) and bisection steps of the boundary search.
+const STEP: f64 = 0.005;
+const BISECTIONS: usize = 20;
+
+impl SerialLegKinematics {
+    /// Joints reaching `target` by Eq. 7.7 from `start` alone (no closest-point search).
+    fn reached_from(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Option<Vector3<f64>> {
+        let tol = 1e-9;
+        let mut q = *start;
+        for _ in 0..self.options.max_iterations {
+            let (p, j) = self.foot_and_jacobian(&q);
+            if (p - target).norm() <= tol {
+                return Some(q);
+            }
+            let dq = j.lu().solve(&(p - target))?;
+            let q_new = self.limits.clamp(&(q - dq));
+            if !((self.foot(&q_new) - target).norm() < (p - target).norm()) {
+                return None;
+            }
+            q = q_new;
+        }
+        ((self.foot(&q) - target).norm() <= tol).then_some(q)
+    }
+
+    /// How far from `centre` (reached with joints `q`) along the unit `direction` the foot
+    /// reaches continuously, up to `limit`.
+    fn reach_along(&self, centre: &Vector3<f64>, mut q: Vector3<f64>, direction: &Vector3<f64>, limit: f64) -> f64 {
+        let mut r = 0.0;
+        while r < limit {
+            let next = (r + STEP).min(limit);
+            match self.reached_from(&(centre + direction * next), &q) {
+                Some(q_next) => (r, q) = (next, q_next),
+                None => {
+                    let (mut inside, mut outside) = (r, next);
+                    for _ in 0..BISECTIONS {
+                        let mid = (inside + outside) / 2.0;
+                        match self.reached_from(&(centre + direction * mid), &q) {
+                            Some(q_mid) => (inside, q) = (mid, q_mid),
+                            None => outside = mid,
+                        }
+                    }
+                    return inside;
+                }
+            }
+        }
+        limit
+    }
+
+    /// The largest radius of a cylinder of axis `axis` (leg frame) over the heights.
+    fn radius_about(&self, axis: &nalgebra::Vector2<f64>, heights: &[f64], limit: f64) -> f64 {
+        let mut radius = limit;
+        for &z in heights {
+            let centre = Vector3::new(axis.x, axis.y, z);
+            let Ok(s) = self.inverse(&centre, &self.limits.middle()) else { return 0.0 };
+            if !s.is_reached() {
+                return 0.0;
+            }
+            for k in 0..DIRECTIONS {
+                let a = std::f64::consts::TAU * k as f64 / DIRECTIONS as f64;
+                radius = radius.min(self.reach_along(&centre, s.joints, &Vector3::new(a.cos(), a.sin(), 0.0), radius));
+            }
+        }
+        radius
+    }
+
+    /// The workspace cylinder for foot heights [z_min, z_max] (leg frame), see the module docs.
+    pub fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
+        if !(z_min.is_finite() && z_max.is_finite() && z_min <= z_max) {
+            return Err(LegKinematicsError::NonFinite("workspace height range"));
+        }
+        let heights: Vec<f64> = (0..HEIGHTS).map(|k| z_min + (z_max - z_min) * k as f64 / (HEIGHTS - 1) as f64).collect();
+        let middle = self.foot(&self.limits.middle());
+        let bisector = nalgebra::Vector2::new(middle.x, middle.y);
+        let reach = self.origins.iter().skip(1).map(|o| o.translation.norm()).sum::<f64>() + self.foot.norm();
+        if !(bisector.norm() > 1e-9) {
+            return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
+        }
+        let u = bisector.normalize();
+        let (d, radius) = argmax(&|d| self.radius_about(&(u * d), &heights, reach), 0.0, reach, 24);
+        if !(radius > 0.0) {
+            return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
+        }
+        Ok(Workspace { centre: u * d, radius, z_min, z_max })
     }
 }
 
@@ -232,6 +322,33 @@ mod tests {
             let s = kin.inverse(&far, &kin.limits().middle()).unwrap();
             let c = s.clamping().expect("out of reach");
             assert!(c.distance > 0.1 && kin.limits().contains(&s.joints), "{c:?}");
+        }
+    }
+
+    /// The workspace at the height of the foot at mid-range: every point of the cylinder is
+    /// reached (Eq. 7.7 from the middle of the ranges), and a cylinder 3 mm wider about the same
+    /// axis is not.
+    #[test]
+    fn the_workspace_is_reachable_and_maximal() {
+        let robot = robot();
+        let mut r = rng(6);
+        for leg in &robot.legs {
+            let kin = SerialLegKinematics::new(leg).unwrap();
+            let z = kin.foot(&kin.limits().middle()).z;
+            let w = kin.workspace(z - 0.01, z + 0.01).unwrap();
+            assert!(w.radius > 0.005, "{w:?}");
+            for _ in 0..200 {
+                let (a, rho, h): (f64, f64, f64) = (r.random_range(0.0..std::f64::consts::TAU), w.radius * r.random::<f64>().sqrt(), r.random_range(w.z_min..=w.z_max));
+                let p = Vector3::new(w.centre.x + rho * a.cos(), w.centre.y + rho * a.sin(), h);
+                assert!(kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached(), "{p:?} in {w:?}");
+            }
+            let wider = (0..64).map(|k| std::f64::consts::TAU * k as f64 / 64.0).any(|a| {
+                [w.z_min, w.z_max, (w.z_min + w.z_max) / 2.0].iter().any(|&h| {
+                    let p = Vector3::new(w.centre.x + (w.radius + 0.003) * a.cos(), w.centre.y + (w.radius + 0.003) * a.sin(), h);
+                    !kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached()
+                })
+            });
+            assert!(wider, "a cylinder 3 mm wider than {w:?} is reached everywhere");
         }
     }
 }
