@@ -356,6 +356,23 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, 
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
 
 
+@cli.command("urdf")
+@click.argument("urdf_file", type=click.Path(path_type=Path))
+@click.option("--height", type=float, default=None, help="Body height (m) for the workspaces [default: feet on the ground with the joints mid-range].")
+@click.option("--lift", type=float, default=0.0, show_default=True, help="Foot lift (m): the workspaces span [ground, ground + lift].")
+def urdf(urdf_file: Path, height: float | None, lift: float) -> None:
+    """Show how hexadyn reads a hexapod's URDF file: legs, joints, masses and workspaces."""
+    import pandas as pd
+
+    from hexadyn.urdf import inspect
+
+    table = inspect(urdf_file, height, lift)
+    a = table.attrs
+    click.echo(f"{a['name']}: {a['mass_kg']:.4g} kg, six legs of three joints; workspaces at body height {a['height_m']:.4g} m, lift {a['lift_m']:.4g} m (leg frames)")
+    with pd.option_context("display.width", 200, "display.max_columns", None, "display.max_colwidth", 60):
+        click.echo(table.drop(columns=["workspace"] if not table["workspace"].any() else []).to_string(float_format=lambda x: f"{x:.4g}"))
+
+
 from hexadyn.view.command import view  # noqa: E402  (hexadyn view: the 3D animation of a results folder)
 
 cli.add_command(view)

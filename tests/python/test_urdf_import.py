@@ -81,3 +81,48 @@ def test_what_cannot_be_modelled_is_refused_in_one_line(case):
     text = str(error.value)
     assert "\n" not in text and text.startswith("robots/my.urdf: "), text
     assert re.search(message, text), text
+
+
+def test_inspect_reports_legs_masses_and_reachable_workspaces(tmp_path):
+    from hexadyn.urdf import inspect, standing_height
+
+    path = tmp_path / "robot.urdf"
+    path.write_text(random_hexapod(2))
+    robot = UrdfHexapod.from_file(str(path))
+    table = inspect(path, lift=0.02)
+    assert list(table.index) == list(range(6)) and table.attrs["height_m"] == pytest.approx(standing_height(robot))
+    assert table.attrs["mass_kg"] == pytest.approx(robot.base_mass + sum(sum(d["link_masses"]) for d in robot.legs))
+    # Mass of the whole model: the multibody's M(q) block of the body translation is m I.
+    assert robot.mass_matrix(np.zeros(24))[0, 0] == pytest.approx(table.attrs["mass_kg"], rel=1e-12)
+    for leg, row in table.iterrows():
+        if row["workspace"]:
+            continue
+        # The cylinder's centre, at the ground and at the lift, is reached from mid-range.
+        z = -table.attrs["height_m"] - robot.legs[leg]["body_from_leg"][2, 3]
+        for height in (z, z + 0.02):
+            _, reached, distance = robot.inverse(leg, [row["workspace_x_m"], row["workspace_y_m"], height])
+            assert reached and distance == 0.0, (leg, height)
+    assert table["workspace"].eq("").sum() >= 4, table["workspace"]
+
+
+def test_the_urdf_command_prints_one_line_per_leg_or_one_error(tmp_path):
+    from click.testing import CliRunner
+
+    from hexadyn.cli import cli
+
+    path = tmp_path / "robot.urdf"
+    path.write_text(random_hexapod(2))
+    result = CliRunner().invoke(cli, ["urdf", str(path), "--lift", "0.01"], prog_name="hexadyn")
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[0].startswith("random_hexapod_2: ") and "six legs of three joints" in lines[0]
+    assert sum(line.split()[0] in "012345" for line in lines[2:]) == 6 and "l1_coxa_joint" in result.output
+    for args, message in (
+        ([str(tmp_path)], "a directory, not a file"),
+        ([str(tmp_path / "none.urdf")], "none.urdf"),
+        ([str(path), "--height", "nan"], "height = nan: allowed a finite body height > 0"),
+        ([str(path), "--lift", "-1"], "lift = -1.0: allowed a finite length >= 0"),
+    ):
+        result = CliRunner().invoke(cli, ["urdf", *args], prog_name="hexadyn")
+        assert result.exit_code == 1 and "Traceback" not in result.output, result.output
+        assert result.output.startswith("Error: ") and message in result.output and result.output.count("\n") == 1, result.output

@@ -2,18 +2,46 @@
 //! multibody system hexadyn simulates: a [`PyMultibody`] (mass matrix, nonlinear effects,
 //! gravity forces, kinetic energy) with the legs' joint names, feet and foot Jacobians.
 
-use hexadyn::description::urdf::serial_hexapod_from_urdf;
-use hexadyn::hexapod::{SerialHexapod, DOF};
-use numpy::{PyArray2, PyArray3, PyReadonlyArray1};
+use hexadyn::description::urdf::{serial_hexapod_from_file, serial_hexapod_from_urdf, UrdfError};
+use hexadyn::hexapod::{SerialHexapod, SerialLegKinematics, DOF, LEG_COUNT};
+use nalgebra::Vector3;
+use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray1, ToPyArray};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::mbs::PyMultibody;
 
 #[pyclass(extends = PyMultibody, name = "UrdfHexapod", module = "hexadyn._core")]
 pub struct PyUrdfHexapod {
     robot: SerialHexapod,
-    feet: [(hexadyn::mbs::BodyId, nalgebra::Vector3<f64>); 6],
+    feet: [(hexadyn::mbs::BodyId, Vector3<f64>); 6],
+    legs: [SerialLegKinematics; 6],
+}
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+impl PyUrdfHexapod {
+    fn build(robot: Result<SerialHexapod, UrdfError>, origin: &str) -> PyResult<PyClassInitializer<Self>> {
+        let robot = robot.map_err(value_error)?;
+        let mechanics = robot.mechanics().map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
+        let legs = SerialLegKinematics::hexapod(&robot.legs).map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
+        let feet = mechanics.feet;
+        Ok(PyClassInitializer::from(PyMultibody::of(mechanics.model)).add_subclass(PyUrdfHexapod { robot, feet, legs }))
+    }
+
+    fn leg(&self, leg: usize) -> PyResult<&SerialLegKinematics> {
+        self.legs.get(leg).ok_or_else(|| PyValueError::new_err(format!("leg = {leg}: allowed 0..{}", LEG_COUNT - 1)))
+    }
+}
+
+fn vector3(name: &str, v: &[f64]) -> PyResult<Vector3<f64>> {
+    match v {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vector3::new(*x, *y, *z)),
+        _ => Err(PyValueError::new_err(format!("{name} = {v:?}: allowed three finite numbers"))),
+    }
 }
 
 #[pymethods]
@@ -23,10 +51,68 @@ impl PyUrdfHexapod {
     #[new]
     #[pyo3(signature = (text, origin = "URDF"))]
     fn new(text: &str, origin: &str) -> PyResult<PyClassInitializer<Self>> {
-        let robot = serial_hexapod_from_urdf(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let mechanics = robot.mechanics().map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
-        let feet = mechanics.feet;
-        Ok(PyClassInitializer::from(PyMultibody::of(mechanics.model)).add_subclass(PyUrdfHexapod { robot, feet }))
+        Self::build(serial_hexapod_from_urdf(text, origin), origin)
+    }
+
+    /// UrdfHexapod.from_file(path): the robot of a URDF file.
+    #[staticmethod]
+    fn from_file(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Py<Self>> {
+        let origin = path.display().to_string();
+        Py::new(py, Self::build(serial_hexapod_from_file(&path), &origin)?)
+    }
+
+    /// Each leg, in the numbering of q: a dict with `joints` (URDF names), `kinds`
+    /// ("revolute" or "prismatic"), `lower` and `upper` (rad or m), `link_masses` (kg, each link
+    /// with the links fixed to it), `foot_radius` (m) and `body_from_leg` (4 x 4 T_{b,l}: the leg
+    /// frame at the first joint with z_l = z_b, Eq. 7.10).
+    #[getter]
+    fn legs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.robot.legs.iter().zip(&self.legs).map(|(leg, kin)| {
+            let d = PyDict::new(py);
+            d.set_item("joints", leg.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>())?;
+            d.set_item("kinds", leg.joints.iter().map(|j| j.kind.name()).collect::<Vec<_>>())?;
+            d.set_item("lower", leg.joints.iter().map(|j| j.lower).collect::<Vec<_>>())?;
+            d.set_item("upper", leg.joints.iter().map(|j| j.upper).collect::<Vec<_>>())?;
+            d.set_item("link_masses", leg.links.iter().map(|l| l.mass).collect::<Vec<_>>())?;
+            d.set_item("foot_radius", leg.foot_radius)?;
+            let t = kin.body_from_leg();
+            let rows: Vec<Vec<f64>> = (0..4).map(|r| (0..4).map(|c| match (r, c) { (3, 3) => 1.0, (3, _) => 0.0, (_, 3) => t.translation[r], _ => t.rotation[(r, c)] }).collect()).collect();
+            d.set_item("body_from_leg", PyArray2::from_vec2(py, &rows)?)?;
+            Ok(d)
+        }).collect()
+    }
+
+    /// The base link's mass with the links fixed to it (kg).
+    #[getter]
+    fn base_mass(&self) -> f64 {
+        self.robot.base.mass
+    }
+
+    /// k(q) of leg `leg`: its foot centre in the leg frame for its three joints `q`.
+    fn foot_in_leg<'py>(&self, py: Python<'py>, leg: usize, q: Vec<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(self.leg(leg)?.foot(&vector3("q", &q)?).as_slice().to_pyarray(py))
+    }
+
+    /// Eq. 7.7 for leg `leg`: joints whose foot is `target` (leg frame) from `start` (default the
+    /// middle of the ranges); returns (joints, reached, distance from the target in m).
+    #[pyo3(signature = (leg, target, start = None))]
+    fn inverse<'py>(&self, py: Python<'py>, leg: usize, target: Vec<f64>, start: Option<Vec<f64>>) -> PyResult<(Bound<'py, PyArray1<f64>>, bool, f64)> {
+        let kin = self.leg(leg)?;
+        let start = start.map_or(Ok(kin.limits().middle()), |s| vector3("start", &s))?;
+        let s = kin.inverse(&vector3("target", &target)?, &start).map_err(value_error)?;
+        Ok((s.joints.as_slice().to_pyarray(py), s.is_reached(), s.clamping().map_or(0.0, |c| c.distance)))
+    }
+
+    /// The workspace cylinder of leg `leg` for foot heights [z_min, z_max] (leg frame, m,
+    /// Section 7.1.1): a dict with `centre` (x, y), `radius`, `z_min`, `z_max`.
+    fn workspace<'py>(&self, py: Python<'py>, leg: usize, z_min: f64, z_max: f64) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.leg(leg)?.workspace(z_min, z_max).map_err(|e| PyValueError::new_err(format!("leg {leg}: {e}")))?;
+        let d = PyDict::new(py);
+        d.set_item("centre", (w.centre.x, w.centre.y))?;
+        d.set_item("radius", w.radius)?;
+        d.set_item("z_min", w.z_min)?;
+        d.set_item("z_max", w.z_max)?;
+        Ok(d)
     }
 
     /// The robot's name (`<robot name>`).

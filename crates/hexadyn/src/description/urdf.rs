@@ -180,6 +180,14 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// Reads a serial hexapod from the URDF file `path` (a regular UTF-8 file within the input size
+/// limit of [`crate::fields::read_input`]).
+pub fn serial_hexapod_from_file(path: impl AsRef<std::path::Path>) -> Result<SerialHexapod, UrdfError> {
+    let file = path.as_ref().display().to_string();
+    let text = crate::fields::read_input(path.as_ref()).map_err(|reason| UrdfError::new(&file, "file", reason, "a readable URDF text file"))?;
+    serial_hexapod_from_urdf(&text, &file)
+}
+
 /// Reads a serial hexapod from URDF `text`; `file` names it in errors.
 pub fn serial_hexapod_from_urdf(text: &str, file: &str) -> Result<SerialHexapod, UrdfError> {
     let robot = urdf_rs::read_from_string(text).map_err(|e| {

@@ -194,8 +194,11 @@ impl SerialLegKinematics {
 
     /// The workspace cylinder for foot heights [z_min, z_max] (leg frame), see the module docs.
     pub fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
-        if !(z_min.is_finite() && z_max.is_finite() && z_min <= z_max) {
+        if !(z_min.is_finite() && z_max.is_finite()) {
             return Err(LegKinematicsError::NonFinite("workspace height range"));
+        }
+        if z_min > z_max {
+            return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
         }
         let heights: Vec<f64> = (0..HEIGHTS).map(|k| z_min + (z_max - z_min) * k as f64 / (HEIGHTS - 1) as f64).collect();
         let middle = self.foot(&self.limits.middle());

@@ -1,0 +1,63 @@
+"""A serial hexapod read from URDF, as hexadyn models it (``hexadyn urdf ROBOT.urdf``): the
+legs it finds (six chains of three actuated joints from the base, fixed joints merged,
+numbered the thesis way: 0, 2, 4 on the left from front to rear, 1, 3, 5 on the right), their
+joints, masses and feet, and each leg's workspace cylinder (Section 7.1.1) for a standing
+height. The rigid-body model behind it is :class:`hexadyn._core.UrdfHexapod` (mass matrix,
+nonlinear effects, feet and foot Jacobians; checked against Pinocchio on the same file)."""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["inspect", "standing_height"]
+
+
+def standing_height(robot) -> float:
+    """The default standing height (m): the body height at which the feet, with every joint at
+    the middle of its range, touch flat ground, i.e. minus the lowest foot in the body frame
+    (the base link's origin) at mid-range."""
+    q = np.zeros(robot.coordinates)
+    for leg, description in enumerate(robot.legs):
+        q[6 + 3 * leg : 9 + 3 * leg] = (np.asarray(description["lower"]) + np.asarray(description["upper"])) / 2
+    return float(-robot.feet(q)[:, 2].min())
+
+
+def inspect(path: str | os.PathLike, height: float | None = None, lift: float = 0.0) -> pd.DataFrame:
+    """One row per leg: its joints (URDF names, kinds, ranges), link masses, foot radius, and
+    the workspace cylinder for a level body at `height` (m, default :func:`standing_height`)
+    with feet lifted up to `lift` (m): centre (x, y) and radius in the leg frame (m), or the
+    reason there is none. ValueError (one line) for a file hexadyn cannot model."""
+    import pandas as pd
+
+    from hexadyn._core import UrdfHexapod
+
+    if not (lift >= 0 and np.isfinite(lift)):
+        raise ValueError(f"lift = {lift!r}: allowed a finite length >= 0 (m)")
+    robot = UrdfHexapod.from_file(os.fspath(path))
+    h = standing_height(robot) if height is None else float(height)
+    if not (h > 0 and np.isfinite(h)):
+        raise ValueError(f"height = {height!r}: allowed a finite body height > 0 (m)")
+    rows = []
+    for leg, d in enumerate(robot.legs):
+        row = {"leg": leg, "joints": ", ".join(d["joints"]), "kinds": ", ".join(d["kinds"])}
+        row["ranges"] = ", ".join(f"[{lo:.3g}, {hi:.3g}]" for lo, hi in zip(d["lower"], d["upper"]))
+        row["mass_kg"] = float(sum(d["link_masses"]))
+        row["foot_radius_m"] = d["foot_radius"]
+        # The foot on flat ground under a level body at height h is at z = -h in the body
+        # frame, -h - z_l in the leg frame whose origin is at height z_l of the body frame.
+        z = -h - float(d["body_from_leg"][2, 3])
+        try:
+            w = robot.workspace(leg, z, z + lift)
+            row.update(workspace_x_m=w["centre"][0], workspace_y_m=w["centre"][1], workspace_radius_m=w["radius"], workspace="")
+        except ValueError as exc:
+            row.update(workspace_x_m=np.nan, workspace_y_m=np.nan, workspace_radius_m=np.nan, workspace=str(exc))
+        rows.append(row)
+    table = pd.DataFrame(rows).set_index("leg")
+    table.attrs.update(name=robot.name, mass_kg=float(robot.base_mass + table["mass_kg"].sum()), height_m=h, lift_m=lift)
+    return table
