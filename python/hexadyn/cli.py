@@ -360,17 +360,22 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, 
 @click.argument("urdf_file", type=click.Path(path_type=Path))
 @click.option("--height", type=float, default=None, help="Body height (m) for the workspaces [default: feet on the ground with the joints mid-range].")
 @click.option("--lift", type=float, default=0.0, show_default=True, help="Foot lift (m): the workspaces span [ground, ground + lift].")
-def urdf(urdf_file: Path, height: float | None, lift: float) -> None:
+@click.option("--mjcf", "mjcf_file", type=click.Path(path_type=Path), default=None, help="Also write the robot as MuJoCo MJCF to this file.")
+def urdf(urdf_file: Path, height: float | None, lift: float, mjcf_file: Path | None) -> None:
     """Show how hexadyn reads a hexapod's URDF file: legs, joints, masses and workspaces."""
     import pandas as pd
 
-    from hexadyn.urdf import inspect
+    from hexadyn.urdf import inspect, write_mjcf
 
     table = inspect(urdf_file, height, lift)
+    if mjcf_file is not None:
+        write_mjcf(urdf_file, mjcf_file)
     a = table.attrs
     click.echo(f"{a['name']}: {a['mass_kg']:.4g} kg, six legs of three joints; workspaces at body height {a['height_m']:.4g} m, lift {a['lift_m']:.4g} m (leg frames)")
     with pd.option_context("display.width", 200, "display.max_columns", None, "display.max_colwidth", 60):
         click.echo(table.drop(columns=["workspace"] if not table["workspace"].any() else []).to_string(float_format=lambda x: f"{x:.4g}"))
+    if mjcf_file is not None:
+        click.echo(f"MJCF: {mjcf_file}")
 
 
 from hexadyn.view.command import view  # noqa: E402  (hexadyn view: the 3D animation of a results folder)

@@ -8,6 +8,7 @@ nonlinear effects, feet and foot Jacobians; checked against Pinocchio on the sam
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -15,7 +16,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["inspect", "standing_height"]
+__all__ = ["inspect", "standing_height", "write_mjcf"]
 
 
 def standing_height(robot) -> float:
@@ -61,3 +62,16 @@ def inspect(path: str | os.PathLike, height: float | None = None, lift: float = 
     table = pd.DataFrame(rows).set_index("leg")
     table.attrs.update(name=robot.name, mass_kg=float(robot.base_mass + table["mass_kg"].sum()), height_m=h, lift_m=lift)
     return table
+
+
+def write_mjcf(urdf: str | os.PathLike, out: str | os.PathLike) -> Path:
+    """Writes the robot of a URDF file as MuJoCo MJCF (:meth:`hexadyn._core.UrdfHexapod.to_mjcf`:
+    the bodies, joints, ranges and inertias hexadyn simulates, fixed links merged, foot spheres
+    and sites ``foot0`` ... ``foot5``) to `out`, atomically; returns `out`."""
+    from hexadyn import atomic
+    from hexadyn._core import UrdfHexapod
+
+    text = UrdfHexapod.from_file(os.fspath(urdf)).to_mjcf()
+    target = Path(out)
+    atomic.write_file(target, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return target

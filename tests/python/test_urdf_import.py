@@ -126,3 +126,19 @@ def test_the_urdf_command_prints_one_line_per_leg_or_one_error(tmp_path):
         result = CliRunner().invoke(cli, ["urdf", *args], prog_name="hexadyn")
         assert result.exit_code == 1 and "Traceback" not in result.output, result.output
         assert result.output.startswith("Error: ") and message in result.output and result.output.count("\n") == 1, result.output
+
+
+def test_the_urdf_command_writes_an_mjcf_file_mujoco_loads(tmp_path):
+    import mujoco
+    from click.testing import CliRunner
+
+    from hexadyn.cli import cli
+
+    path = tmp_path / "robot.urdf"
+    path.write_text(random_hexapod(6))
+    out = tmp_path / "robot.xml"
+    result = CliRunner().invoke(cli, ["urdf", str(path), "--mjcf", str(out)], prog_name="hexadyn")
+    assert result.exit_code == 0 and f"MJCF: {out}" in result.output, result.output
+    model = mujoco.MjModel.from_xml_path(str(out))
+    assert model.body_mass.sum() == pytest.approx(UrdfHexapod.from_file(str(path)).mass_matrix(np.zeros(24))[0, 0], rel=1e-12)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["robot.urdf", "robot.xml"], "no temporary left"

@@ -2,6 +2,7 @@
 //! multibody system hexadyn simulates: a [`PyMultibody`] (mass matrix, nonlinear effects,
 //! gravity forces, kinetic energy) with the legs' joint names, feet and foot Jacobians.
 
+use hexadyn::description::mjcf::serial_hexapod_to_mjcf;
 use hexadyn::description::urdf::{serial_hexapod_from_file, serial_hexapod_from_urdf, UrdfError};
 use hexadyn::hexapod::{SerialHexapod, SerialLegKinematics, DOF, LEG_COUNT};
 use nalgebra::Vector3;
@@ -80,6 +81,12 @@ impl PyUrdfHexapod {
             d.set_item("body_from_leg", PyArray2::from_vec2(py, &rows)?)?;
             Ok(d)
         }).collect()
+    }
+
+    /// The robot as MuJoCo's MJCF text (`description::mjcf`): the same bodies, joints, ranges,
+    /// inertias, foot spheres (sites `foot0` ... `foot5`) and gravity, joints in the order of q.
+    fn to_mjcf(&self) -> String {
+        serial_hexapod_to_mjcf(&self.robot, hexadyn::mbs::STANDARD_GRAVITY)
     }
 
     /// The base link's mass with the links fixed to it (kg).

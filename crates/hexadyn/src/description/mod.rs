@@ -29,6 +29,7 @@
 use std::path::Path;
 
 mod tables;
+pub mod mjcf;
 pub mod urdf;
 mod hexapod_parameters;
 mod monte_carlo;
