@@ -17,7 +17,7 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup chromium run test lint test-rust test-python bench bench-peer bench-montecarlo terrains lock clean
+.PHONY: help setup chromium run test lint test-rust test-python bench bench-peer bench-urdf bench-montecarlo terrains lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
@@ -26,6 +26,7 @@ help:
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
 	@echo "make bench-peer  the 75 s walk in hexadyn and in MuJoCo, timed in the same run"
+	@echo "make bench-urdf  a URDF hexapod's mass matrix and nonlinear effects in hexadyn and in Pinocchio"
 	@echo "make bench-montecarlo [MC_ARGS=\"--runs 50\"]  time a Monte Carlo campaign on every core (long)"
 	@echo "make terrains  regenerate the shipped terrain PLY files (python/hexadyn/scenarios/terrains)"
 	@echo "make lock   re-resolve requirements/lock.txt"
@@ -89,6 +90,10 @@ terrains:
 bench-peer: setup
 	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) mujoco
 	$(PY) benches/peer_mujoco.py
+
+# Rigid-body evaluation of a serial hexapod from URDF, against Pinocchio (a test dependency).
+bench-urdf: setup
+	$(PY) benches/urdf_rigid_body.py
 
 # Optional: the full campaign (1000 runs x 4 velocities x 2 variants) takes hours on a laptop.
 bench-montecarlo: setup
