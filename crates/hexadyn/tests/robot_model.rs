@@ -229,7 +229,7 @@ fn coordinate_counts_of_table_3_5_and_section_4_5() {
         o.control = JointControl::ContinuousPid { t_d: 0.0, n: 10.0, omega_0: 1000.0 };
     });
     assert_eq!(full.model.coordinate_count(), 96);
-    assert_eq!(full.model.mechanics.model.body_count(), 49);
+    assert_eq!(full.model.multibody.body_count(), 49);
     assert_eq!(robot(FrictionModel::LuGre, |_| {}).model.coordinate_count(), 42);
 }
 

@@ -16,9 +16,9 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::description::{JointFrictionParameters, RobotDescription};
-use crate::hexapod::{joint_index, LegJoints, Mechanics, MechanicsParameters, PantographJoint, DOF, JOINTS};
-use crate::mbs::{self, Data};
+use crate::description::{JointFrictionParameters, PiGains, RobotDescription};
+use crate::hexapod::{joint_index, JointKind, LegJoints, Mechanics, MechanicsParameters, PantographJoint, DOF, JOINTS};
+use crate::mbs::{self, BodyId, Data};
 use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
 use crate::physics::{limit_switch, saturate, DcMotor};
@@ -110,17 +110,39 @@ impl ModelOptions {
     }
 }
 
+/// A robot's mechanism and drives, whatever its legs (the pantograph of the description file,
+/// serial legs): what [`RobotModel::assemble`] makes one residual system of.
+#[derive(Clone)]
+pub struct RobotParts {
+    /// The multibody model on the coordinates of Eq. 3.51.
+    pub multibody: mbs::Model,
+    /// Each foot: its body and the foot point in that body's frame.
+    pub feet: [(BodyId, Vector3<f64>); 6],
+    /// The names and kinds of a leg's joints.
+    pub joints: LegJoints,
+    /// Per joint k = 3 leg + j.
+    pub motors: [DcMotor; JOINTS],
+    pub friction: [FrictionElement; JOINTS],
+    /// Joint strokes (limit switches).
+    pub strokes: [RangeInclusive<f64>; JOINTS],
+    /// PI gains of each joint, for the continuous controllers of [`JointControl::ContinuousPid`].
+    pub pi_gains: [PiGains; JOINTS],
+}
+
 /// The immutable robot model: mechanics, motors, friction elements, contact and terrain.
 #[derive(Clone)]
 pub struct RobotModel {
-    pub mechanics: Mechanics,
+    /// The multibody model (Section 3.3.3): AMRU5's 49 bodies, or a serial robot's 19.
+    pub multibody: mbs::Model,
+    /// Each foot: its body and the foot point in that body's frame.
+    pub feet: [(BodyId, Vector3<f64>); 6],
     /// The names and kinds of a leg's joints: the layout's and the results' column names.
     pub joints: LegJoints,
-    /// Per joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+    /// Per joint k = 3 leg + j (AMRU5: 0 q_r, 1 q_v, 2 q_h).
     pub motors: [DcMotor; JOINTS],
     pub friction: [FrictionElement; JOINTS],
-    /// Joint strokes (limit switches), per joint type.
-    pub strokes: [RangeInclusive<f64>; 3],
+    /// Joint strokes (limit switches), per joint.
+    pub strokes: [RangeInclusive<f64>; JOINTS],
     pub options: ModelOptions,
     pub terrain: Arc<dyn Terrain>,
     /// Continuous joint controllers (Eq. 3.96-3.97), with [`JointControl::ContinuousPid`].
@@ -158,6 +180,7 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: PantographJoint, op
 }
 
 impl RobotModel {
+    /// The robot of a (pantograph) robot description.
     pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
         let motor = |joint: PantographJoint| DcMotor {
@@ -168,22 +191,38 @@ impl RobotModel {
             n: d.reduction(joint),
             inductance: options.inductance,
         };
-        let motors = std::array::from_fn(|k| motor(PantographJoint::ALL[k % 3]));
-        let friction = std::array::from_fn(|k| friction_element(d, k / 3, PantographJoint::ALL[k % 3], &options));
-        let strokes = PantographJoint::ALL.map(|j| {
-            let (lo, hi) = d.joint_range(j);
-            lo..=hi
-        });
+        let parts = RobotParts {
+            feet: std::array::from_fn(|leg| (mechanics.legs[leg].links[3], mechanics.foot_local)),
+            multibody: mechanics.model,
+            joints: d.joints.names.clone(),
+            motors: std::array::from_fn(|k| motor(PantographJoint::ALL[k % 3])),
+            friction: std::array::from_fn(|k| friction_element(d, k / 3, PantographJoint::ALL[k % 3], &options)),
+            strokes: std::array::from_fn(|k| {
+                let (lo, hi) = d.joint_range(PantographJoint::ALL[k % 3]);
+                lo..=hi
+            }),
+            pi_gains: std::array::from_fn(|k| d.pi_gains(PantographJoint::ALL[k % 3])),
+        };
+        Self::assemble(parts, options, terrain)
+    }
 
+    /// The robot of `parts` as one residual system: the layout of its coordinates (the joints'
+    /// scales by their kind: 1e-5 rad, 1e-7 m), the bristle, current and PID states the options
+    /// ask for.
+    pub fn assemble(parts: RobotParts, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
+        let RobotParts { multibody, feet, joints, mut motors, friction, strokes, pi_gains } = parts;
+        for motor in &mut motors {
+            motor.inductance = options.inductance;
+        }
         let mut layout = Layout::default();
         let names = ["X", "Y", "Z", "yaw", "pitch", "roll"];
         for (i, name) in names.iter().enumerate() {
             layout.push(*name, Order::Second, if i < 3 { 1e-6 } else { 1e-5 }, "multibody (main body)");
         }
-        let joints = d.joints.names.clone();
         let joint_name = |k: usize| joints.column("", k, "");
+        let revolute = |k: usize| joints.kind(k % 3) == JointKind::Revolute;
         for k in 0..JOINTS {
-            let scale = if k % 3 == 0 { 1e-5 } else { 1e-7 };
+            let scale = if revolute(k) { 1e-5 } else { 1e-7 };
             layout.push(joint_name(k), Order::Second, scale, format!("multibody (leg {})", k / 3));
         }
         let bristles = (options.friction == FrictionModel::LuGre).then(|| {
@@ -204,21 +243,18 @@ impl RobotModel {
         });
         let pids = match options.control {
             JointControl::Digital => None,
-            JointControl::ContinuousPid { t_d, n, omega_0 } => Some(std::array::from_fn(|k| {
-                let g = d.pi_gains(PantographJoint::ALL[k % 3]);
-                ContinuousPid { k: g.k, t_i: g.t_i, t_d, n, omega_0 }
-            })),
+            JointControl::ContinuousPid { t_d, n, omega_0 } => Some(std::array::from_fn(|k| ContinuousPid { k: pi_gains[k].k, t_i: pi_gains[k].t_i, t_d, n, omega_0 })),
         };
         let pid = pids.is_some().then(|| {
             let first = layout.len();
             for k in 0..JOINTS {
                 let element = format!("PID {}", joint_name(k));
                 layout.push(format!("q_u_{}", joint_name(k)), Order::First, 1e-3, element.clone());
-                layout.push(format!("q_I_{}", joint_name(k)), Order::Second, if k % 3 == 0 { 1e-6 } else { 1e-8 }, element);
+                layout.push(format!("q_I_{}", joint_name(k)), Order::Second, if revolute(k) { 1e-6 } else { 1e-8 }, element);
             }
             first
         });
-        RobotModel { mechanics, joints, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
+        RobotModel { multibody, feet, joints, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
     }
 
     /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance,
@@ -244,13 +280,12 @@ impl RobotModel {
         // z_b = n: R_y(Θ) R_x(Ψ) e_z = (sin Θ cos Ψ, −sin Ψ, cos Θ cos Ψ) (Eq. 3.52 with Φ = 0).
         let n = self.terrain.height_normal(0.0, 0.0).1;
         (q[4], q[5]) = (n.x.atan2(n.z), (-n.y).asin());
-        let mech = &self.mechanics;
-        let mut data = Data::new(&mech.model);
+        let mut data = Data::new(&self.multibody);
         let mut clearance = |q: &[f64]| {
-            mbs::kinematics(&mech.model, &mut data, &q[..DOF], &[0.0; DOF]);
-            mech.legs
+            mbs::kinematics(&self.multibody, &mut data, &q[..DOF], &[0.0; DOF]);
+            self.feet
                 .iter()
-                .map(|b| -self.terrain.proximity(&data.point(b.links[3], &mech.foot_local), self.options.ground.foot_radius).penetration)
+                .map(|(body, point)| -self.terrain.proximity(&data.point(*body, point), self.options.ground.foot_radius).penetration)
                 .fold(f64::INFINITY, f64::min)
         };
         q[2] = -clearance(&q);
@@ -361,7 +396,7 @@ impl InertialJacobian {
 
 impl Robot {
     pub fn new(model: Arc<RobotModel>) -> Self {
-        let data = Data::new(&model.mechanics.model);
+        let data = Data::new(&model.multibody);
         Robot { model, data, kinematics_at: None, voltages: [0.0; JOINTS], references: [0.0; JOINTS], outputs: Outputs::default(), inertial: None, vicinity: Default::default(), feet: None, surrogate: None }
     }
 
@@ -376,14 +411,14 @@ impl Robot {
     fn kinematics(&mut self, q: &[f64], qd: &[f64]) {
         let at = (q[..DOF].try_into().expect("DOF coordinates"), qd[..DOF].try_into().expect("DOF coordinates"));
         if self.kinematics_at != Some(at) {
-            mbs::relative_kinematics(&self.model.mechanics.model, &mut self.data, &q[..DOF], &qd[..DOF]);
+            mbs::relative_kinematics(&self.model.multibody, &mut self.data, &q[..DOF], &qd[..DOF]);
             self.kinematics_at = Some(at);
         }
     }
 
     /// The partial velocities of every body at the last kinematics (mass matrix, foot Jacobians).
     fn partial_velocities(&mut self) {
-        mbs::partial_velocities(&self.model.mechanics.model, &mut self.data);
+        mbs::partial_velocities(&self.model.multibody, &mut self.data);
     }
 
     /// Multibody rows with the contact and joint forces frozen at `contact` and `joint`
@@ -391,17 +426,16 @@ impl Robot {
     #[allow(clippy::too_many_arguments)] // the state (q, q', q''), the two frozen forces, two outputs
     fn frozen_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], contact: &[Vector3<f64>; 6], joint: &[f64; JOINTS], f: &mut [f64], feet: &mut [Vector3<f64>; 6]) {
         self.kinematics(q, qd);
-        let mech = &self.model.mechanics;
         self.data.clear_forces();
-        for (leg, bodies) in mech.legs.iter().enumerate() {
-            let p = self.data.point(bodies.links[3], &mech.foot_local);
-            feet[leg] = self.data.point_velocity(bodies.links[3], &p);
-            self.data.add_force(bodies.links[3], &p, &contact[leg]);
+        for (leg, (body, point)) in self.model.feet.iter().enumerate() {
+            let p = self.data.point(*body, point);
+            feet[leg] = self.data.point_velocity(*body, &p);
+            self.data.add_force(*body, &p, &contact[leg]);
         }
         for (k, tau) in joint.iter().enumerate() {
             self.data.add_generalized_force(6 + k, *tau);
         }
-        mbs::residual(&mech.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
+        mbs::residual(&self.model.multibody, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
     }
 
     /// Forward differences of [`Self::frozen_residual`] over q and q' (Eq. 3.12): an iteration
@@ -413,7 +447,7 @@ impl Robot {
         let joint: [f64; JOINTS] = std::array::from_fn(|k| self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
         let scales = self.model.layout.scales.clone();
         let mut mass = zero_matrix(DOF, DOF);
-        mbs::mass_matrix(&self.model.mechanics.model, &self.data, &mut mass);
+        mbs::mass_matrix(&self.model.multibody, &self.data, &mut mass);
         let mut jac = InertialJacobian { q: q.to_vec(), kt: zero_matrix(DOF, DOF), ct: zero_matrix(DOF, DOF), dv_dq: vec![nalgebra::Matrix3xX::zeros(DOF); 6], mass };
         let (mut f0, mut fp) = (vec![0.0; DOF], vec![0.0; DOF]);
         let (mut v0, mut vp) = ([Vector3::zeros(); 6], [Vector3::zeros(); 6]);
@@ -449,7 +483,7 @@ impl Robot {
         match self.model.pids {
             None => {
                 for k in 0..JOINTS {
-                    self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k % 3]);
+                    self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k]);
                 }
             }
             Some(_) => self.references = command.references,
@@ -461,10 +495,9 @@ impl Robot {
     pub fn evaluate(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) {
         self.kinematics(q, qd);
         let m = &*self.model;
-        let mech = &m.mechanics;
         let feet: [Foot; 6] = std::array::from_fn(|leg| {
-            let link = mech.legs[leg].links[3];
-            let position = self.data.point(link, &mech.foot_local);
+            let (link, point) = m.feet[leg];
+            let position = self.data.point(link, &point);
             let velocity = self.data.point_velocity(link, &position);
             let proximity = m.terrain.proximity_near(&position, m.options.ground.foot_radius, &mut self.vicinity[leg]);
             Foot { position, velocity, proximity }
@@ -472,11 +505,10 @@ impl Robot {
         self.force_laws(qd, qdd, &feet);
         self.feet = Some(feet);
         self.data.clear_forces();
-        let mech = &self.model.mechanics;
-        for (leg, bodies) in mech.legs.iter().enumerate() {
+        for (leg, (body, _)) in self.model.feet.iter().enumerate() {
             let force = self.outputs.contact[leg].force;
             if force != Vector3::zeros() {
-                self.data.add_force(bodies.links[3], &feet[leg].position, &force);
+                self.data.add_force(*body, &feet[leg].position, &force);
             }
         }
         for k in 0..JOINTS {
@@ -520,7 +552,7 @@ impl Robot {
 
     fn write_residual(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         self.evaluate(q, qd, qdd);
-        mbs::residual(&self.model.mechanics.model, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
+        mbs::residual(&self.model.multibody, &mut self.data, &qdd[..DOF], &mut f[..DOF]);
         self.write_state_rows(q, qd, qdd, f);
     }
 
@@ -554,7 +586,7 @@ impl Robot {
     /// the state of the last [`Robot::evaluate`].
     fn write_mass_matrix(&self, qd: &[f64], qdd: &[f64], mass: &mut DMatrix<f64>) {
         let m = &*self.model;
-        mbs::mass_matrix(&m.mechanics.model, &self.data, mass);
+        mbs::mass_matrix(&m.multibody, &self.data, mass);
         self.write_state_mass(qd, qdd, mass);
     }
 
@@ -631,17 +663,16 @@ impl System for Robot {
         jac.kt.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.kt);
         jac.ct.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.ct);
         let m = &*self.model;
-        let mech = &m.mechanics;
         // Contact (Eq. 3.72-3.73): f contains −J_footᵀ F, F(p(q), v(q, q')).
         let mut dfn_dq = [nalgebra::RowSVector::<f64, DOF>::zeros(); 6];
         let mut dfn_dqd = [nalgebra::RowSVector::<f64, DOF>::zeros(); 6];
-        for (leg, bodies) in mech.legs.iter().enumerate() {
+        for (leg, (body, _)) in m.feet.iter().enumerate() {
             let c = &self.outputs.contact[leg];
             if c.df_dp == nalgebra::Matrix3::zeros() && c.df_dv == nalgebra::Matrix3::zeros() {
                 continue;
             }
             let mut j_foot = nalgebra::SMatrix::<f64, 3, DOF>::zeros();
-            for (col, d) in self.data.point_partial_velocities(&mech.model, bodies.links[3], &self.outputs.foot[leg]) {
+            for (col, d) in self.data.point_partial_velocities(&m.multibody, *body, &self.outputs.foot[leg]) {
                 j_foot.set_column(col, &d);
             }
             let df_dq = c.df_dp * j_foot + c.df_dv * &inertial.dv_dq[leg];

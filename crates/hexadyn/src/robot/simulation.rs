@@ -80,8 +80,8 @@ impl EnergyAccount {
         // At a control instant the reset after the input jump moves q'' alone: (q, q'), and with
         // them the kinetic and potential energies, are those accumulated last, at the same t.
         if self.powers.as_ref().is_none_or(|prev| prev.t != state.t) {
-            self.kinetic = mbs::kinetic_energy(&m.mechanics.model, robot.data());
-            self.potential = mbs::potential_energy(&m.mechanics.model, robot.data());
+            self.kinetic = mbs::kinetic_energy(&m.multibody, robot.data());
+            self.potential = mbs::potential_energy(&m.multibody, robot.data());
         }
         if let Some(prev) = &self.powers {
             let h = 0.5 * (p.t - prev.t);

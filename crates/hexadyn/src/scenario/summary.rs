@@ -260,7 +260,7 @@ impl RunStats {
             if cmd.voltages[k].abs() >= supply {
                 self.saturated += 1;
             }
-            let held = crate::physics::limit_switch(cmd.voltages[k], q[6 + k], &model.strokes[k % 3]);
+            let held = crate::physics::limit_switch(cmd.voltages[k], q[6 + k], &model.strokes[k]);
             if held == 0.0 && cmd.voltages[k] != 0.0 {
                 self.cuts += 1;
             }
@@ -308,7 +308,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         initial_body_height_m: q0[2],
         body_height_change_m: q[2] - q0[2],
         body_horizontal_drift_m: (q[0] - q0[0]).hypot(q[1] - q0[1]),
-        robot_mass_kg: plant.robot.model.mechanics.model.total_mass(),
+        robot_mass_kg: plant.robot.model.multibody.total_mass(),
         energy_electrical_j: sum(&e.electrical),
         energy_electrical_by_joint_j: std::array::from_fn(|j| e.electrical.iter().skip(j).step_by(3).sum()),
         joints: plant.robot.model.joints.clone(),
@@ -326,7 +326,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         limit_switch_cuts: stats.cuts,
         max_tracking_error: s.control.tracks_references().then_some(stats.tracking),
         max_penetration_m: stats.max_penetration,
-        static_penetration_m: s.model.ground.static_penetration(plant.robot.model.mechanics.model.total_mass() * crate::mbs::STANDARD_GRAVITY / 3.0),
+        static_penetration_m: s.model.ground.static_penetration(plant.robot.model.multibody.total_mass() * crate::mbs::STANDARD_GRAVITY / 3.0),
         gait: None,
     }
 }

@@ -106,10 +106,10 @@ impl Robot {
     pub(super) fn write_surrogate(&mut self, base: &mut Surrogate, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         if base.j_foot.is_none() {
             self.kinematics(&base.q, &base.qd);
-            let mech = &self.model.mechanics;
+            let m = &self.model;
             base.j_foot = Some(std::array::from_fn(|leg| {
                 let mut foot = FootJacobian { leg, j: SMatrix::zeros() };
-                for (c, d) in self.data.point_partial_velocity_terms(&mech.model, mech.legs[leg].links[3], base.feet[leg].position) {
+                for (c, d) in self.data.point_partial_velocity_terms(&m.multibody, m.feet[leg].0, base.feet[leg].position) {
                     let mut column = foot.j.column_mut(foot.column(c));
                     column += d;
                 }
