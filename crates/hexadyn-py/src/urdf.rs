@@ -4,7 +4,7 @@
 
 use hexadyn::description::mjcf::serial_hexapod_to_mjcf;
 use hexadyn::description::urdf::{serial_hexapod_from_file, serial_hexapod_from_urdf, UrdfError};
-use hexadyn::hexapod::{SerialHexapod, SerialLegKinematics, DOF, LEG_COUNT};
+use hexadyn::hexapod::{Leg, LegChain, SerialHexapod, SerialLegKinematics, DOF, LEG_COUNT};
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArray2, PyArray3, PyReadonlyArray1, ToPyArray};
 use pyo3::exceptions::PyValueError;

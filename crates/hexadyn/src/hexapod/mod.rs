@@ -23,7 +23,7 @@ pub mod workspace;
 
 pub use joints::{JointKind, JointNameError, LegJoints};
 pub use leg_dynamics::{joint_torques, leg_joint_torques, StillBody};
-pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, LegChain, LegKinematics, LegKinematicsError, Limit, SerialLegKinematics};
+pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, Leg, LegChain, LegKinematics, LegKinematicsError, Limit, SerialLegKinematics};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::{PantographGeometry, PantographJoint};
 pub use serial::{Link, SerialHexapod, SerialJoint, SerialLeg, SerialMechanics};

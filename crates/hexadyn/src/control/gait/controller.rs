@@ -13,7 +13,7 @@ use super::walk::{LegState, Walk};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
 use crate::control::{pi_command, BodyPose, Command, Controller, DigitalPi, Measurements};
-use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
 /// How the AEP is found during the swing (Section 7.5).
@@ -71,10 +71,11 @@ pub struct GaitDiagnostics {
     pub gait_switches: usize,
 }
 
-/// The periodic/omnidirectional gait controller on flat ground.
-pub struct GaitController {
+/// The periodic/omnidirectional gait controller on flat ground, for legs of any mechanism
+/// (AMRU5's pantographs by default, [`crate::hexapod::SerialLegKinematics`] for serial legs).
+pub struct GaitController<L: LegMechanism = LegKinematics> {
     pub options: GaitOptions,
-    legs_kinematics: [LegKinematics; 6],
+    legs_kinematics: [L; 6],
     workspaces: [Workspace; 6],
     pis: [DigitalPi; JOINTS],
     heading: Box<dyn HeadingSource>,
@@ -85,8 +86,8 @@ pub struct GaitController {
     pub diagnostics: GaitDiagnostics,
 }
 
-impl GaitController {
-    pub fn new(options: GaitOptions, legs: [LegKinematics; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
+impl<L: LegMechanism> GaitController<L> {
+    pub fn new(options: GaitOptions, legs: [L; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
         let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), swing_time: 0.0, foot: Vector3::zeros(), joints: Vector3::zeros() };
         GaitController { options, legs_kinematics: legs, workspaces, pis, heading, walk: Walk { body: None, legs: [idle; 6] }, origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
     }
@@ -201,13 +202,12 @@ impl GaitController {
     }
 }
 
-/// The joints that put every foot at its foothold (leg frames), found by Eq. 7.7 from the
-/// neutral posture. The error is the first leg that cannot reach its foothold.
-pub fn joints_at(legs: &[LegKinematics; 6], footholds: &[Vector3<f64>; 6]) -> Result<[f64; JOINTS], usize> {
-    let neutral = Vector3::new(0.0, 0.06, 0.03);
+/// The joints that put every foot at its foothold (leg frames), found by Eq. 7.7 from each
+/// leg's neutral posture ([`LegMechanism::neutral`]). The error is the first leg that cannot reach its foothold.
+pub fn joints_at<L: LegMechanism>(legs: &[L; 6], footholds: &[Vector3<f64>; 6]) -> Result<[f64; JOINTS], usize> {
     let mut joints = [0.0; JOINTS];
     for l in 0..6 {
-        match legs[l].inverse(&footholds[l], &neutral) {
+        match legs[l].inverse(&footholds[l], &legs[l].neutral()) {
             Ok(ik) if ik.is_reached() => joints[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice()),
             _ => return Err(l),
         }
@@ -217,7 +217,7 @@ pub fn joints_at(legs: &[LegKinematics; 6], footholds: &[Vector3<f64>; 6]) -> Re
 
 /// The standing posture: every foot at the centre of its workspace on the ground `height` below
 /// the body (leg frame z = −height).
-pub fn joints_at_workspace_centres(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64) -> Result<[f64; JOINTS], usize> {
+pub fn joints_at_workspace_centres<L: LegMechanism>(legs: &[L; 6], workspaces: &[Workspace; 6], height: f64) -> Result<[f64; JOINTS], usize> {
     joints_at(legs, &std::array::from_fn(|l| workspaces[l].centre_at(-height)))
 }
 
@@ -235,7 +235,7 @@ pub fn joints_at_workspace_centres(legs: &[LegKinematics; 6], workspaces: &[Work
 /// fraction u into its swing stands where the steady swing would carry it, PEP + u (AEP − PEP) =
 /// C + v_C s T (u − 1/2), and swings to its AEP in the rest of the swing. Every AEP is the
 /// steady one, so the walk from the first swing on is the steady walk.
-pub fn steady_footholds(legs: &[LegKinematics; 6], workspaces: &[Workspace; 6], height: f64, options: &GaitOptions, start: &Heading) -> [Vector3<f64>; 6] {
+pub fn steady_footholds<L: LegMechanism>(legs: &[L; 6], workspaces: &[Workspace; 6], height: f64, options: &GaitOptions, start: &Heading) -> [Vector3<f64>; 6] {
     let beta = options.pattern.beta;
     let cycle = options.cycle;
     let support = cycle.support_fraction(beta);
@@ -270,11 +270,11 @@ pub(super) fn estimated_pose(m: &Measurements, desired: &Pose) -> Htm {
 
 /// Eq. 7.25 in the leg frame: the commanded velocity v_C/0 of the workspace centre `c_leg` (leg
 /// frame), for the leg frame `frame` = T_{0,b} T_{b,l} and the body pose `body` = T_{0,b}.
-pub(super) fn centre_velocity(kin: &LegKinematics, c_leg: &Vector3<f64>, frame: &Htm, body: &Htm, heading: &Heading) -> Vector3<f64> {
+pub(super) fn centre_velocity<L: LegMechanism>(kin: &L, c_leg: &Vector3<f64>, frame: &Htm, body: &Htm, heading: &Heading) -> Vector3<f64> {
     frame.rotation.transpose() * heading.point_velocity(&(body.rotation * kin.to_body(c_leg)))
 }
 
-impl Controller for GaitController {
+impl<L: LegMechanism> Controller for GaitController<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let h = self.heading.heading(m.t);
         if let Some(body) = &mut self.walk.body {

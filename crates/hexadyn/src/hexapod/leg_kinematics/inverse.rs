@@ -12,6 +12,65 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::{JointLimits, LegKinematics, LegKinematicsError, RzMinus};
+use crate::spatial::Htm;
+
+/// A leg as the gait controllers use it (Chapter 7), whatever its mechanism: its chain (k(q),
+/// J(q), the inverse of Eq. 7.7) and its frame on the body (Eq. 7.10). The leg frame's origin
+/// is at the height of the body frame's, z_l = z_b, so that a foot on flat ground under a level
+/// body at height h is at z = −h in every leg frame.
+pub trait Leg: LegChain {
+    /// T_{b,l}.
+    fn body_from_leg(&self) -> Htm;
+    /// A point of the leg frame in the body frame.
+    fn to_body(&self, p_leg: &Vector3<f64>) -> Vector3<f64> {
+        self.body_from_leg().apply(p_leg)
+    }
+    /// A point of the body frame in the leg frame.
+    fn to_leg(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
+        let t = self.body_from_leg();
+        t.rotation.transpose() * (p_body - t.translation)
+    }
+    /// A direction (or velocity) of the body frame in the leg frame.
+    fn direction_to_leg(&self, v_body: &Vector3<f64>) -> Vector3<f64> {
+        self.body_from_leg().rotation.transpose() * v_body
+    }
+    /// {p_F/b}_b: the foot in the body frame (Eq. 7.10 without T_{0,b}).
+    fn foot_in_body(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        self.to_body(&self.foot(q))
+    }
+    /// The joints Eq. 7.7 starts from when there are no current ones (a standing posture).
+    fn neutral(&self) -> Vector3<f64>;
+    /// [`inverse`] (Eq. 7.7) of a target in the leg frame from `start`.
+    fn inverse(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
+        inverse(self, target, start)
+    }
+    /// Inverse kinematics of a target given in the body frame.
+    fn inverse_in_body(&self, target_body: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
+        Leg::inverse(self, &self.to_leg(target_body), start)
+    }
+}
+
+impl Leg for LegKinematics {
+    fn body_from_leg(&self) -> Htm {
+        LegKinematics::body_from_leg(self)
+    }
+    fn to_body(&self, p_leg: &Vector3<f64>) -> Vector3<f64> {
+        LegKinematics::to_body(self, p_leg)
+    }
+    fn to_leg(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
+        LegKinematics::to_leg(self, p_body)
+    }
+    fn direction_to_leg(&self, v_body: &Vector3<f64>) -> Vector3<f64> {
+        LegKinematics::direction_to_leg(self, v_body)
+    }
+    fn foot_in_body(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        LegKinematics::foot_in_body(self, q)
+    }
+    /// The neutral posture of Section 4.1 with q_h = 0.03 m.
+    fn neutral(&self) -> Vector3<f64> {
+        Vector3::new(0.0, 0.06, 0.03)
+    }
+}
 
 /// What the inverse kinematics of Eq. 7.7 needs of a leg mechanism, whatever it is (the
 /// pantograph, a serial chain): k(q) and J(q) in the leg frame, the joint ranges and the
@@ -54,6 +113,9 @@ impl LegChain for LegKinematics {
     }
     fn assembles(&self, q: &Vector3<f64>) -> bool {
         self.pantograph.closes(q[1], q[2])
+    }
+    fn foot(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        LegKinematics::foot(self, q)
     }
     /// q_r aimed at the target's azimuth: the foot's azimuth is −q_r + atan2(s_y, s_x).
     fn aimed(&self, target: &Vector3<f64>, q0: &Vector3<f64>, foot: &Vector3<f64>) -> Option<(usize, f64)> {

@@ -51,7 +51,7 @@ use crate::spatial::{rotation_about, Htm};
 
 mod inverse;
 mod serial;
-pub use inverse::{inverse, Clamping, IkOptions, IkOutcome, IkSolution, LegChain, Limit};
+pub use inverse::{inverse, Clamping, IkOptions, IkOutcome, IkSolution, Leg, LegChain, Limit};
 pub use serial::SerialLegKinematics;
 
 /// Errors of the leg kinematics: an unusable geometry or non-finite inputs.

@@ -4,9 +4,11 @@
 //! # The leg frame `l`
 //!
 //! As for the pantograph (Eq. 7.10), the leg frame is fixed to the body with z_l = z_b: its
-//! origin is the first joint's origin and x_l points along the first joint's x axis projected
-//! on the body's horizontal plane (the leg's mounting direction), so that the gaits' foot
-//! heights and workspace cylinders stay vertical whatever the mounting.
+//! origin is the first joint's origin brought to the height of the body frame's (a foot on
+//! flat ground under a level body at height h is at z = −h in every leg frame) and x_l points
+//! along the first joint's x axis projected on the body's horizontal plane (the leg's mounting
+//! direction), so that the gaits' foot heights and workspace cylinders stay vertical whatever
+//! the mounting.
 //!
 //! # k(q) and J(q)
 //!
@@ -17,7 +19,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::inverse::{inverse, IkOptions, IkSolution, LegChain};
+use super::inverse::{inverse, IkOptions, Leg, LegChain};
 use super::{JointLimits, LegKinematicsError};
 use crate::hexapod::workspace::{argmax, Workspace};
 use crate::hexapod::{JointKind, SerialLeg};
@@ -45,7 +47,7 @@ impl SerialLegKinematics {
         let first = leg.joints[0].origin;
         let x = first.rotation.column(0);
         let yaw = if x.xy().norm() > 1e-9 { x.y.atan2(x.x) } else { 0.0 };
-        let body_from_leg = Htm { rotation: rotation_about(&Vector3::z(), yaw), translation: first.translation };
+        let body_from_leg = Htm { rotation: rotation_about(&Vector3::z(), yaw), translation: Vector3::new(first.translation.x, first.translation.y, 0.0) };
         let origins = [body_from_leg.inverse().compose(&first), leg.joints[1].origin, leg.joints[2].origin];
         Ok(SerialLegKinematics {
             body_from_leg,
@@ -62,65 +64,6 @@ impl SerialLegKinematics {
     pub fn hexapod(legs: &[SerialLeg; 6]) -> Result<[Self; 6], LegKinematicsError> {
         let legs = legs.iter().map(Self::new).collect::<Result<Vec<_>, _>>()?;
         Ok(legs.try_into().expect("six legs"))
-    }
-
-    pub fn limits(&self) -> &JointLimits {
-        &self.limits
-    }
-
-    /// T_{b,l}.
-    pub fn body_from_leg(&self) -> Htm {
-        self.body_from_leg
-    }
-
-    /// A point of the leg frame in the body frame.
-    pub fn to_body(&self, p_leg: &Vector3<f64>) -> Vector3<f64> {
-        self.body_from_leg.apply(p_leg)
-    }
-
-    /// A point of the body frame in the leg frame.
-    pub fn to_leg(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
-        self.body_from_leg.rotation.transpose() * (p_body - self.body_from_leg.translation)
-    }
-
-    /// k(q): the foot centre in the leg frame.
-    pub fn foot(&self, q: &Vector3<f64>) -> Vector3<f64> {
-        self.foot_and_jacobian(q).0
-    }
-
-    /// k(q) and the geometric Jacobian J = ∂k/∂q.
-    pub fn foot_and_jacobian(&self, q: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
-        let mut t = Htm::identity();
-        let mut axes = [(Vector3::zeros(), Vector3::zeros()); 3];
-        for k in 0..3 {
-            t = t.compose(&self.origins[k]);
-            let a = t.rotation * self.axes[k];
-            axes[k] = (a, t.translation);
-            let motion = match self.kinds[k] {
-                JointKind::Revolute => Htm { rotation: rotation_about(&self.axes[k], q[k]), translation: Vector3::zeros() },
-                JointKind::Prismatic => Htm { rotation: Matrix3::identity(), translation: self.axes[k] * q[k] },
-            };
-            t = t.compose(&motion);
-        }
-        let p = t.apply(&self.foot);
-        let column = |k: usize| {
-            let (a, o) = axes[k];
-            match self.kinds[k] {
-                JointKind::Revolute => a.cross(&(p - o)),
-                JointKind::Prismatic => a,
-            }
-        };
-        (p, Matrix3::from_columns(&[column(0), column(1), column(2)]))
-    }
-
-    /// [`inverse`] (Eq. 7.7) of a target in the leg frame from `start`.
-    pub fn inverse(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
-        inverse(self, target, start)
-    }
-
-    /// Inverse kinematics of a target given in the body frame.
-    pub fn inverse_in_body(&self, target_body: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
-        self.inverse(&self.to_leg(target_body), start)
     }
 }
 
@@ -180,7 +123,7 @@ impl SerialLegKinematics {
         let mut radius = limit;
         for &z in heights {
             let centre = Vector3::new(axis.x, axis.y, z);
-            let Ok(s) = self.inverse(&centre, &self.limits.middle()) else { return 0.0 };
+            let Ok(s) = inverse(self, &centre, &self.limits.middle()) else { return 0.0 };
             if !s.is_reached() {
                 return 0.0;
             }
@@ -216,9 +159,40 @@ impl SerialLegKinematics {
     }
 }
 
+impl Leg for SerialLegKinematics {
+    fn body_from_leg(&self) -> Htm {
+        self.body_from_leg
+    }
+    /// The middle of the ranges.
+    fn neutral(&self) -> Vector3<f64> {
+        self.limits.middle()
+    }
+}
+
 impl LegChain for SerialLegKinematics {
+    /// k(q) and the geometric Jacobian J = ∂k/∂q.
     fn foot_and_jacobian(&self, q: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
-        SerialLegKinematics::foot_and_jacobian(self, q)
+        let mut t = Htm::identity();
+        let mut axes = [(Vector3::zeros(), Vector3::zeros()); 3];
+        for k in 0..3 {
+            t = t.compose(&self.origins[k]);
+            let a = t.rotation * self.axes[k];
+            axes[k] = (a, t.translation);
+            let motion = match self.kinds[k] {
+                JointKind::Revolute => Htm { rotation: rotation_about(&self.axes[k], q[k]), translation: Vector3::zeros() },
+                JointKind::Prismatic => Htm { rotation: Matrix3::identity(), translation: self.axes[k] * q[k] },
+            };
+            t = t.compose(&motion);
+        }
+        let p = t.apply(&self.foot);
+        let column = |k: usize| {
+            let (a, o) = axes[k];
+            match self.kinds[k] {
+                JointKind::Revolute => a.cross(&(p - o)),
+                JointKind::Prismatic => a,
+            }
+        };
+        (p, Matrix3::from_columns(&[column(0), column(1), column(2)]))
     }
     fn limits(&self) -> &JointLimits {
         &self.limits
