@@ -16,16 +16,18 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, Vector3};
 
-use crate::description::{JointFrictionParameters, PiGains, RobotDescription};
-use crate::hexapod::{joint_index, JointKind, LegJoints, Mechanics, MechanicsParameters, PantographJoint, DOF, JOINTS};
+use crate::description::RobotDescription;
+use crate::hexapod::{joint_index, JointKind, LegJoints, DOF, JOINTS};
 use crate::mbs::{self, BodyId, Data};
 use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
-use crate::physics::{FrictionElement, JointFriction, LuGre, SteadyState};
+use crate::physics::{FrictionElement, JointFriction};
 use crate::physics::{limit_switch, saturate, DcMotor};
 use crate::control::{Command, ContinuousPid};
 use crate::sim::{zero_matrix, Jacobian, Layout, Order, System};
 
+mod parts;
 mod surrogate;
+pub use parts::RobotParts;
 use surrogate::Surrogate;
 
 
@@ -110,25 +112,6 @@ impl ModelOptions {
     }
 }
 
-/// A robot's mechanism and drives, whatever its legs (the pantograph of the description file,
-/// serial legs): what [`RobotModel::assemble`] makes one residual system of.
-#[derive(Clone)]
-pub struct RobotParts {
-    /// The multibody model on the coordinates of Eq. 3.51.
-    pub multibody: mbs::Model,
-    /// Each foot: its body and the foot point in that body's frame.
-    pub feet: [(BodyId, Vector3<f64>); 6],
-    /// The names and kinds of a leg's joints.
-    pub joints: LegJoints,
-    /// Per joint k = 3 leg + j.
-    pub motors: [DcMotor; JOINTS],
-    pub friction: [FrictionElement; JOINTS],
-    /// Joint strokes (limit switches).
-    pub strokes: [RangeInclusive<f64>; JOINTS],
-    /// PI gains of each joint, for the continuous controllers of [`JointControl::ContinuousPid`].
-    pub pi_gains: [PiGains; JOINTS],
-}
-
 /// The immutable robot model: mechanics, motors, friction elements, contact and terrain.
 #[derive(Clone)]
 pub struct RobotModel {
@@ -154,56 +137,10 @@ pub struct RobotModel {
     pid: Option<usize>,
 }
 
-fn friction_element(d: &RobotDescription, leg: usize, joint: PantographJoint, options: &ModelOptions) -> FrictionElement {
-    // The description's parameters carry the thesis names of the laws' parameters.
-    let parameters = d.friction(leg, joint);
-    let JointFrictionParameters { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, f_v_plus, f_v_minus, q_st, sigma_0, sigma_1, v_d, load_dependence, .. } = parameters;
-    let law = match options.friction {
-        FrictionModel::None => JointFriction::None,
-        FrictionModel::DryViscous => JointFriction::DryViscous(parameters.dry_viscous()),
-        FrictionModel::LuGre => {
-            // Section 6.1: g of Eq. 6.2-6.3 (rotation), 6.4 (vertical, with stiction) and 6.5
-            // (horizontal, viscous effects neglected).
-            let (steady, f_v_plus, f_v_minus) = match (joint, q_st) {
-                (PantographJoint::Vertical, Some(qd_st)) => (SteadyState::Stribeck { tau_f_d_plus, tau_f_d_minus, tau_f_s_plus, tau_f_s_minus, qd_st }, f_v_plus, f_v_minus),
-                (PantographJoint::Horizontal, _) => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, 0.0, 0.0),
-                _ => (SteadyState::Dry { tau_f_d_plus, tau_f_d_minus }, f_v_plus, f_v_minus),
-            };
-            JointFriction::LuGre(LuGre { sigma_0, sigma_1, v_d, f_v_plus, f_v_minus, steady })
-        }
-    };
-    let element = FrictionElement::new(law);
-    match (options.load_dependence, options.friction, load_dependence) {
-        (true, FrictionModel::DryViscous | FrictionModel::LuGre, Some(load)) => element.with_load(load),
-        _ => element,
-    }
-}
-
 impl RobotModel {
     /// The robot of a (pantograph) robot description.
     pub fn new(d: &RobotDescription, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
-        let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
-        let motor = |joint: PantographJoint| DcMotor {
-            r: d.motor.resistance_ohm,
-            r_bridge: d.driver.series_resistance_ohm(),
-            l: d.motor.inductance_h(),
-            k_t: d.motor.torque_constant_nm_per_a,
-            n: d.reduction(joint),
-            inductance: options.inductance,
-        };
-        let parts = RobotParts {
-            feet: std::array::from_fn(|leg| (mechanics.legs[leg].links[3], mechanics.foot_local)),
-            multibody: mechanics.model,
-            joints: d.joints.names.clone(),
-            motors: std::array::from_fn(|k| motor(PantographJoint::ALL[k % 3])),
-            friction: std::array::from_fn(|k| friction_element(d, k / 3, PantographJoint::ALL[k % 3], &options)),
-            strokes: std::array::from_fn(|k| {
-                let (lo, hi) = d.joint_range(PantographJoint::ALL[k % 3]);
-                lo..=hi
-            }),
-            pi_gains: std::array::from_fn(|k| d.pi_gains(PantographJoint::ALL[k % 3])),
-        };
-        Self::assemble(parts, options, terrain)
+        Self::assemble(RobotParts::from_description(d, &options), options, terrain)
     }
 
     /// The robot of `parts` as one residual system: the layout of its coordinates (the joints'
