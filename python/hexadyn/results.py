@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import errno
+import functools
 import json
 import math
 import os
@@ -178,10 +179,10 @@ class Results:
             raise ValueError("these results hold no time series (not in memory, no results folder)")
         return self.path / TIMESERIES_FILE
 
-    @property
+    @functools.cached_property
     def joints(self) -> Joints:
         """The names and kinds of the robot's leg joints (:class:`hexadyn.vocabulary.Joints`),
-        read from the robot description stored with the results."""
+        read once from the robot description stored with the results."""
         return Joints.of(self)
 
     @property
