@@ -175,7 +175,7 @@ def _magnetic_energy_change(results: Results) -> np.ndarray:
     (``[model] inductance = true``, Eq. 3.91)."""
     if not _models_inductance(results):
         return np.zeros(len(results.joints.actuators))
-    inductance = _robot_properties(results)["inductance_h"]
+    inductance = np.tile(_robot_properties(results)["inductance_h"], len(LEGS))
     i = results.endpoints()[_columns(results, "i")].to_numpy()
     return 0.5 * inductance * (i[-1] ** 2 - i[0] ** 2)
 

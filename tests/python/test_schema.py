@@ -31,7 +31,7 @@ def test_robot_properties(walk: Results):
     props = _core.robot_properties((ROOT / "robots" / "amru5.toml").read_text())
     assert props["mass_kg"] == pytest.approx(walk.summary["robot_mass_kg"], rel=1e-12), "m_0 + 6 m_leg, summed in another order"
     assert props["stated_mass_kg"] == 34.0
-    assert props["inductance_h"] == pytest.approx(0.09e-3, rel=1e-12)
+    assert props["inductance_h"] == pytest.approx((0.09e-3,) * 3, rel=1e-12)
     assert props["joints"] == (("q_r", "revolute"), ("q_v", "prismatic"), ("q_h", "prismatic"))
     assert _core.robot_properties(walk.metadata["robot"]) == props
     with pytest.raises(ValueError, match=r"^my robot:.*inertia\.leg_mass_kg"):

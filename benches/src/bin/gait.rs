@@ -34,7 +34,7 @@ fn controller(d: &RobotDescription, period: f64, vx: f64) -> (GaitController, [f
     let lift = 0.045;
     let workspaces = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, lift).unwrap());
     let joints = joints_at_workspace_centres(&legs, &workspaces, height).unwrap();
-    let pis = joint_pis(d, d.controller.period_s);
+    let pis = joint_pis(&d.joint_pi_gains(), d.controller.period_s);
     let options = GaitOptions { period, pattern: GaitPattern::tripod(), cycle: FootCycle::Enhanced { overlap: 0.05 }, aep: AepMode::Omnidirectional, lift, dt: d.controller.period_s };
     (GaitController::new(options, legs, workspaces, pis, Box::new(Constant(Heading::new(vx, 0.0, 0.0)))), joints)
 }
@@ -79,7 +79,7 @@ fn main() {
     let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
     let workspaces: [_; 6] = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, 0.045).unwrap());
     let options = FreeGaitOptions { body_height: height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg: None, stability_margin: 0.02, dt: 0.01, elevator: true };
-    let mut free = FreeGaitController::new(options, legs.clone(), workspaces, joint_pis(&d, 0.01), Box::new(Constant(Heading::new(0.01, 0.0, 0.0))), Box::new(NormalForce { threshold: THESIS_FORCE_THRESHOLD }));
+    let mut free = FreeGaitController::new(options, legs.clone(), workspaces, joint_pis(&d.joint_pi_gains(), 0.01), Box::new(Constant(Heading::new(0.01, 0.0, 0.0))), Box::new(NormalForce { threshold: THESIS_FORCE_THRESHOLD }));
     let mut m = Measurements { t: 0.0, positions: joints_at_workspace_centres(&legs, &workspaces, height).unwrap(), currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: Some([100.0; 6]) };
     let (mut plain, mut posture) = (Vec::new(), Vec::new());
     for i in 0..30_000 {
@@ -117,7 +117,7 @@ fn main() {
     let q = model.touching_ground(&joints);
     let qd = vec![0.0; q.len()];
     let start = Instant::now();
-    let options = PlantOptions::from_description(&d, &model.options);
+    let options = PlantOptions::new(d.controller.period_s, &model.options);
     let mut plant = SimulatedRobot::new(model, &q, &qd, &options).unwrap();
     run(&mut plant, &mut c, 75.0, |_, _, _| {}).unwrap();
     let wall = start.elapsed().as_secs_f64();

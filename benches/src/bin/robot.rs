@@ -31,7 +31,7 @@ fn main() {
             });
             let q = model.touching_ground(&base);
             let qd = vec![0.0; q.len()];
-            let pis = joint_pis(&d, d.controller.period_s);
+            let pis = joint_pis(&d.joint_pi_gains(), d.controller.period_s);
             let motions = if lifted {
                 vec![(3, JointMotion::Sawtooth { min: -0.35, max: 0.35, speed: 0.15 }), (4, JointMotion::Sawtooth { min: 0.04, max: 0.05, speed: 0.004 }), (5, JointMotion::Sawtooth { min: 0.01, max: 0.05, speed: 0.004 })]
             } else {
@@ -39,7 +39,7 @@ fn main() {
             };
             let mut controller = JointPiController { pis, references: JointReferences { base, motions } };
             let start = Instant::now();
-            let options = PlantOptions::from_description(&d, &model.options);
+            let options = PlantOptions::new(d.controller.period_s, &model.options);
             let mut plant = SimulatedRobot::new(model, &q, &qd, &options).expect("initial state");
             run(&mut plant, &mut controller, duration, |_, _, _| {}).expect("simulation");
             let wall = start.elapsed().as_secs_f64();

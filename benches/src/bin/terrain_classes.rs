@@ -84,7 +84,7 @@ fn run(class: &TerrainClass, seed: u64) -> (String, Result<Verdict, String>, f64
     ];
     let mut s = Scenario::from_file_with(&path, &overrides).expect("the shipped free-gait scenario with valid overrides");
     s.terrain = seeded.terrain.clone();
-    let mut judge = Judge::new(seeded.terrain.as_ref(), seeded.nominal_normal, BodyBottom::of(&s.robot), Bounds::default());
+    let mut judge = Judge::new(seeded.terrain.as_ref(), seeded.nominal_normal, BodyBottom::of(s.robot.pantograph().expect("the AMRU5 free-gait scenario")), Bounds::default());
     let mut missing = None;
     let mut last_t = 0.0;
     let outcome = run_scenario_chunked(

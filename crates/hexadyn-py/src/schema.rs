@@ -5,7 +5,7 @@
 
 use hexadyn::control::gait::pattern::FootPhase;
 use hexadyn::control::gait::schedule::FAILED_LEG_CODE;
-use hexadyn::description::RobotDescription;
+use hexadyn::description::Robot;
 use hexadyn::hexapod::LEG_COUNT;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -34,8 +34,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// - "mass_kg": m_0 + 6 m_leg (Table B.2), the mass the engine simulates and reports as the
 ///   summary's `robot_mass_kg`;
 /// - "stated_mass_kg": `inertia.total_mass_kg`, the total mass as printed in Table B.2
-///   ("about 34 kg", checked against m_0 + 6 m_leg within 5 %);
-/// - "inductance_h": the motor inductance L (H) of Eq. 3.91;
+///   ("about 34 kg", checked against m_0 + 6 m_leg within 5 %); a serial robot's total mass;
+/// - "inductance_h": the motor inductance L (H) of Eq. 3.91 of each joint of a leg;
+/// - "leg_mechanism": "pantograph" or "serial";
 /// - "joints": the names and kinds of a leg's three joints in the order of q, a tuple of
 ///   `(name, kind)` pairs, kind `"revolute"` or `"prismatic"` (AMRU5: `("q_r", "revolute")`,
 ///   `("q_v", "prismatic")`, `("q_h", "prismatic")`): the names of the results columns.
@@ -44,12 +45,21 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 #[pyo3(signature = (text, origin = "robot description"))]
 pub fn robot_properties<'py>(py: Python<'py>, text: &str, origin: &str) -> PyResult<Bound<'py, PyDict>> {
-    let robot = RobotDescription::from_str(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let robot = Robot::from_str(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let d = PyDict::new(py);
     d.set_item("mass_kg", robot.total_mass_kg())?;
-    d.set_item("stated_mass_kg", robot.inertia.total_mass_kg)?;
-    d.set_item("inductance_h", robot.motor.inductance_h())?;
-    let joints = &robot.joints.names;
+    d.set_item("leg_mechanism", robot.leg_mechanism())?;
+    match &robot {
+        Robot::Pantograph(p) => {
+            d.set_item("stated_mass_kg", p.inertia.total_mass_kg)?;
+            d.set_item("inductance_h", PyTuple::new(py, [p.motor.inductance_h(); 3])?)?;
+        }
+        Robot::Serial(s) => {
+            d.set_item("stated_mass_kg", s.total_mass_kg())?;
+            d.set_item("inductance_h", PyTuple::new(py, s.drives.iter().map(|drive| drive.motor.inductance_mh * 1e-3))?)?;
+        }
+    }
+    let joints = robot.joints();
     d.set_item("joints", PyTuple::new(py, (0..3).map(|j| (joints.name(j), joints.kind(j).name())))?)?;
     Ok(d)
 }

@@ -89,6 +89,13 @@ impl PyUrdfHexapod {
         serial_hexapod_to_mjcf(&self.robot, hexadyn::mbs::STANDARD_GRAVITY)
     }
 
+    /// The mechanism tables of a serial robot description (`description::serial::mechanism_toml`)
+    /// with the per-leg joint names `joint_names`: what `hexadyn import-urdf` writes before the
+    /// drives.
+    fn mechanism_toml(&self, joint_names: [String; 3]) -> String {
+        hexadyn::description::serial::mechanism_toml(&self.robot, &joint_names)
+    }
+
     /// The base link's mass with the links fixed to it (kg).
     #[getter]
     fn base_mass(&self) -> f64 {

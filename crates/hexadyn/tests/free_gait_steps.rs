@@ -31,7 +31,7 @@ fn walk_onto(rise: f64, seed: u64, elevator: bool) -> (Verdict, String) {
     let mut s = Scenario::from_file_with(&path, &overrides).unwrap_or_else(|e| panic!("{e}"));
     s.terrain = seeded.terrain.clone();
     let r = run_scenario(&s, |_| {}).unwrap();
-    let mut judge = Judge::new(seeded.terrain.as_ref(), seeded.nominal_normal, BodyBottom::of(&s.robot), Bounds::default());
+    let mut judge = Judge::new(seeded.terrain.as_ref(), seeded.nominal_normal, BodyBottom::of(s.robot.pantograph().expect("the AMRU5 free-gait scenario")), Bounds::default());
     let _ = judge.observe(&r.series).unwrap();
     (judge.finish(SPEED * duration), seeded.drawn)
 }

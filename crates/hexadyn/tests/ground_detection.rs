@@ -126,7 +126,7 @@ fn no_false_detection_over_100_swing_phases() {
             self.walk.update(m)
         }
     }
-    let mut spy = Spy { walk: ScenarioController::new(&s), detector: GroundDetector::new(&s.robot, s.period(), 40.0).unwrap(), out: detections.clone() };
+    let mut spy = Spy { walk: ScenarioController::new(&s), detector: GroundDetector::new(s.robot.pantograph().unwrap(), s.period(), 40.0).unwrap(), out: detections.clone() };
     let mut plant = settled_robot(&s).unwrap();
     let (mut swings, mut in_air, mut max_lowering) = (0, [false; 6], 0.0f64);
     run(&mut plant, &mut spy, s.duration, |p, _, _| {

@@ -57,7 +57,7 @@ fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRu
 /// emulator latched for that sequence number: no corrupted, stale or foreign packet reached
 /// the controller.
 fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) {
-    let encoders: [Encoder; JOINTS] = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: s.robot.reduction(PantographJoint::ALL[k % 3]) });
+    let encoders: [Encoder; JOINTS] = s.model().encoders;
     let periods = run.series.values("period").expect("period column");
     for (row, &p) in periods.iter().enumerate() {
         if run.series.values("last_reply").expect("last_reply")[row].is_nan() {

@@ -313,7 +313,7 @@ fn input_change_is_the_difference_of_two_residuals() {
 #[test]
 fn reset_after_an_input_jump_matches_the_newton_reset() {
     let d = RobotDescription::amru5();
-    let options = PlantOptions::from_description(&d, &robot(FrictionModel::LuGre, |_| {}).model.options).integrator;
+    let options = PlantOptions::new(d.controller.period_s, &robot(FrictionModel::LuGre, |_| {}).model.options).integrator;
     assert!(options.surrogate_iterations > 0);
     reset_after_an_input_jump(NewmarkOptions { surrogate_iterations: 0, ..options.clone() });
     reset_after_an_input_jump(options);

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
+use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, GaitLegs, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
 use hexadyn::sim::NewmarkOptions;
 use hexadyn::description::AMRU5_TOML;
 use hexadyn::hexapod::PantographJoint;
@@ -71,7 +71,7 @@ fn shipped_scenarios_are_valid() {
     assert_eq!(s.initial.lifted_legs, vec![1, 2, 5]);
     assert_eq!(s.model.supply_voltage, 15.0);
     // 0.8 x the no-load speed (Section 4.4.3).
-    let d = &s.robot;
+    let d = s.robot.pantograph().expect("AMRU5");
     let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(PantographJoint::Vertical);
     match s.motions[0].motion {
         hexadyn::control::JointMotion::Ramp { rate: r, .. } => assert!((r - rate).abs() < 1e-6 * rate, "{r} vs {rate}"),
@@ -417,11 +417,12 @@ fn walking_scenarios_parse() {
     assert!((g.body_height - 0.414).abs() < 1e-3, "{}", g.body_height);
     assert_eq!(s.initial.joints, g.joints);
     assert!(s.initial.settle && s.initial.lifted_legs.is_empty());
+    let GaitLegs::Pantograph(legs) = &g.legs else { panic!("AMRU5's pantograph legs") };
     for l in 0..6 {
         let q = nalgebra::Vector3::new(g.joints[3 * l], g.joints[3 * l + 1], g.joints[3 * l + 2]);
-        let foot = g.legs[l].foot_in_body(&q);
+        let foot = legs[l].foot_in_body(&q);
         let ahead = if [0, 3, 4].contains(&l) { 0.045 } else { -0.045 };
-        let expected = g.legs[l].to_body(&g.workspaces[l].centre_at(-g.body_height)) + nalgebra::Vector3::new(ahead, 0.0, 0.0);
+        let expected = legs[l].to_body(&g.workspaces[l].centre_at(-g.body_height)) + nalgebra::Vector3::new(ahead, 0.0, 0.0);
         assert!((foot - expected).norm() < 1e-6, "leg {l}: {foot:?} instead of {expected:?}");
     }
     assert!(!s.plant.navigation);
@@ -719,18 +720,18 @@ fn overrides_set_fields_and_joint_friction_for_every_leg() {
     }
     let unchanged = Scenario::from_file(scenarios_dir().join("validation_tripod_1_5cm.toml")).unwrap();
     for leg in 0..6 {
-        let (f, g) = (s.robot.friction(leg, PantographJoint::Rotation), unchanged.robot.friction(leg, PantographJoint::Rotation));
+        let (f, g) = (s.robot.pantograph().unwrap().friction(leg, PantographJoint::Rotation), unchanged.robot.pantograph().unwrap().friction(leg, PantographJoint::Rotation));
         assert_eq!((f.tau_f_d_plus, f.f_v_minus), (8.04, 16.17));
         assert_eq!((f.tau_f_d_minus, f.f_v_plus), (g.tau_f_d_minus, g.f_v_plus), "keys left out keep the per-leg values");
-        let h = s.robot.friction(leg, PantographJoint::Horizontal);
+        let h = s.robot.pantograph().unwrap().friction(leg, PantographJoint::Horizontal);
         let a = h.load_dependence.unwrap();
         assert_eq!((h.f_v_plus, a.a_2_plus, a.a_1_minus), (0.0, 5.5, -2.0));
-        assert_eq!(a.a_2_minus, unchanged.robot.friction(leg, PantographJoint::Horizontal).load_dependence.unwrap().a_2_minus);
+        assert_eq!(a.a_2_minus, unchanged.robot.pantograph().unwrap().friction(leg, PantographJoint::Horizontal).load_dependence.unwrap().a_2_minus);
     }
     // The effective text is kept (results folders hold what ran) and reads back the same.
     assert!(s.text.contains("vx_m_s = 0.01") && s.text.starts_with('#'), "{}", s.text);
     let again = Scenario::from_str(&s.text, "effective.toml", &scenarios_dir()).unwrap();
-    assert_eq!(again.robot.friction(3, PantographJoint::Horizontal), s.robot.friction(3, PantographJoint::Horizontal));
+    assert_eq!(again.robot.pantograph().unwrap().friction(3, PantographJoint::Horizontal), s.robot.pantograph().unwrap().friction(3, PantographJoint::Horizontal));
 }
 
 #[test]

@@ -19,7 +19,7 @@ fn model(friction: FrictionModel, tweak: impl FnOnce(&mut ModelOptions)) -> Arc<
 }
 
 fn pis(d: &RobotDescription) -> [DigitalPi; JOINTS] {
-    joint_pis(d, d.controller.period_s)
+    joint_pis(&d.joint_pi_gains(), d.controller.period_s)
 }
 
 /// Legs 0, 3, 4 support the body; legs 1, 2, 5 are lifted.
@@ -42,7 +42,7 @@ fn energy_balance_closes_for_every_friction_model() {
         let base = tripod_stance();
         let q = m.touching_ground(&base);
         let qd = vec![0.0; q.len()];
-        let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::from_description(&d, &m.options)).unwrap();
+        let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::new(d.controller.period_s, &m.options)).unwrap();
         let mut motions = Vec::new();
         for leg in [1, 2, 5] {
             motions.push((3 * leg, JointMotion::Sine { amplitude: 0.1, frequency_hz: 0.5 }));
@@ -87,7 +87,7 @@ fn ramp_at_80_percent_of_no_load_speed() {
     let mut q = m.touching_ground(&base);
     q[2] += 0.5; // the whole robot in the air, body held by nothing but its own dynamics for 0.6 s
     let qd = vec![0.0; q.len()];
-    let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::from_description(&d, &m.options)).unwrap();
+    let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::new(d.controller.period_s, &m.options)).unwrap();
     let rate = 0.8 * d.motor.no_load_speed_rad_per_s() / d.reduction(PantographJoint::Vertical);
     let motions = vec![(k, JointMotion::Ramp { rate, start_s: 0.0, stop_s: 10.0 })];
     let mut controller = JointPiController { pis: pis(&d), references: JointReferences { base, motions } };
@@ -121,7 +121,7 @@ fn continuous_pid_model_tracks_like_the_digital_controllers() {
         });
         let q = m.touching_ground(&base);
         let qd = vec![0.0; q.len()];
-        let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::from_description(&d, &m.options)).unwrap();
+        let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &PlantOptions::new(d.controller.period_s, &m.options)).unwrap();
         let references = JointReferences { base, motions: motions.clone() };
         let mut worst: f64 = 0.0;
         let mut track = |p: &SimulatedRobot, meas: &hexadyn::control::Measurements, cmd: &hexadyn::control::Command| {

@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use hexadyn::control::{DigitalPi, JointPiController, JointReferences};
+use hexadyn::control::{DigitalPi, Encoder, JointPiController, JointReferences};
 use hexadyn::description::urdf::serial_hexapod_from_urdf;
 use hexadyn::description::PiGains;
 use hexadyn::hexapod::{JointKind, Leg, LegChain, LegJoints, SerialHexapod, SerialLegKinematics, JOINTS};
@@ -39,6 +39,8 @@ fn model(robot: &SerialHexapod) -> Arc<RobotModel> {
             j.lower..=j.upper
         }),
         pi_gains: [PI_GAINS; JOINTS],
+        encoders: [Encoder { counts_per_rev: 4096, n: motor.n }; JOINTS],
+        servos: None,
     };
     let options = ModelOptions {
         friction: FrictionModel::DryViscous,
@@ -78,7 +80,7 @@ fn a_urdf_hexapod_stands_under_pi_control_and_its_energy_account_closes() {
     let base = standing_joints(&robot);
     let q = m.touching_ground(&base);
     let qd = vec![0.0; q.len()];
-    let options = PlantOptions { integrator: NewmarkOptions { tolerance: 1.0, h_max: PERIOD, h_initial: 1e-4, gamma: 0.6, beta: 0.3025, ..Default::default() }, period: PERIOD, encoder_counts: 4096, navigation: false, current_sensing: Default::default() };
+    let options = PlantOptions { integrator: NewmarkOptions { tolerance: 1.0, h_max: PERIOD, h_initial: 1e-4, gamma: 0.6, beta: 0.3025, ..Default::default() }, period: PERIOD, navigation: false, current_sensing: Default::default() };
     let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &options).unwrap();
     let mut controller = JointPiController { pis: std::array::from_fn(|_| DigitalPi::new(PI_GAINS.k, PI_GAINS.t_i, PERIOD)), references: JointReferences { base, motions: Vec::new() } };
     let z0 = q[2];
@@ -139,7 +141,7 @@ fn walk_tripod(robot: &SerialHexapod) -> Result<Walked, String> {
     let joints = joints_at(&legs, &footholds).map_err(|l| format!("leg {l}: its steady foothold is out of reach"))?;
     let q = m.touching_ground(&joints);
     let qd = vec![0.0; q.len()];
-    let plant_options = PlantOptions { integrator: NewmarkOptions { tolerance: 1.0, h_max: PERIOD, h_initial: 1e-4, gamma: 0.6, beta: 0.3025, ..Default::default() }, period: PERIOD, encoder_counts: 4096, navigation: false, current_sensing: Default::default() };
+    let plant_options = PlantOptions { integrator: NewmarkOptions { tolerance: 1.0, h_max: PERIOD, h_initial: 1e-4, gamma: 0.6, beta: 0.3025, ..Default::default() }, period: PERIOD, navigation: false, current_sensing: Default::default() };
     let mut plant = SimulatedRobot::new(m.clone(), &q, &qd, &plant_options).unwrap();
     let pis = std::array::from_fn(|_| DigitalPi::new(PI_GAINS.k, PI_GAINS.t_i, PERIOD));
     let mut controller = GaitController::new(options, legs, workspaces, pis, Box::new(heading));

@@ -38,10 +38,10 @@ fn walk_lifting(lift: f64, friction: FrictionModel, heading: Box<dyn HeadingSour
     let model = Arc::new(RobotModel::new(&d, model_options, Arc::new(FlatGround { height: 0.0 })));
     let q = model.touching_ground(&joints);
     let qd = vec![0.0; q.len()];
-    let mut plant_options = PlantOptions::from_description(&d, &model.options);
+    let mut plant_options = PlantOptions::new(d.controller.period_s, &model.options);
     plant_options.navigation = navigation;
     let plant = SimulatedRobot::new(model, &q, &qd, &plant_options).unwrap();
-    let pis = joint_pis(&d, d.controller.period_s);
+    let pis = joint_pis(&d.joint_pi_gains(), d.controller.period_s);
     let options = GaitOptions { period: 12.0, pattern: GaitPattern::tripod(), cycle, aep, lift, dt: d.controller.period_s };
     Walk { plant, controller: GaitController::new(options, legs, workspaces, pis, heading) }
 }

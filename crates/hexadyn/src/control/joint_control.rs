@@ -4,16 +4,13 @@ use std::f64::consts::TAU;
 
 use super::interface::{Command, Controller, Measurements};
 use super::DigitalPi;
-use crate::description::RobotDescription;
-use crate::hexapod::{PantographJoint, JOINTS};
+use crate::description::PiGains;
+use crate::hexapod::JOINTS;
 
-/// The 18 digital PI of a robot (gains K, T_i of its description, Table 4.1 for AMRU5) at the
-/// control period `dt`, joint k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
-pub fn joint_pis(robot: &RobotDescription, dt: f64) -> [DigitalPi; JOINTS] {
-    std::array::from_fn(|k| {
-        let g = robot.pi_gains(PantographJoint::ALL[k % 3]);
-        DigitalPi::new(g.k, g.t_i, dt)
-    })
+/// The 18 digital PI of a robot with the gains K, T_i of each joint k = 3 leg + j (Table 4.1 for
+/// AMRU5, [`crate::description::Robot::pi_gains`]) at the control period `dt`.
+pub fn joint_pis(gains: &[PiGains; JOINTS], dt: f64) -> [DigitalPi; JOINTS] {
+    std::array::from_fn(|k| DigitalPi::new(gains[k].k, gains[k].t_i, dt))
 }
 
 /// The command of the 18 digital PI position loops (Eq. 4.18-4.20, antiwindup at the supply

@@ -12,6 +12,7 @@ mod interface;
 mod joint_control;
 mod low_pass;
 mod pi;
+mod servo;
 mod torque_estimation;
 
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant};
@@ -21,3 +22,4 @@ pub use ground_experiment::{GroundExperiment, GroundExperimentController, Ground
 pub use low_pass::{DigitalLowPass, DIGITAL_CUTOFF_HZ};
 pub use torque_estimation::{TorqueEstimate, TorqueEstimator};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};
+pub use servo::{PositionServo, ServoVoltage};

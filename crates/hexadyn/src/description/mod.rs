@@ -33,6 +33,8 @@ pub mod mjcf;
 pub mod urdf;
 mod hexapod_parameters;
 mod monte_carlo;
+mod robot;
+pub mod serial;
 mod si;
 mod validate;
 mod values;
@@ -40,6 +42,8 @@ mod values;
 pub use crate::fields::{DescriptionError, FieldError};
 pub use tables::*;
 pub use monte_carlo::{across_legs, LoadDependenceDistribution};
+pub use robot::Robot;
+pub use serial::SerialRobot;
 pub use si::{JointFrictionParameters, PiGains};
 pub use values::{Gaussian, Interval, Measured, PerLeg, PerLegMaybe, Sweep};
 
@@ -47,6 +51,13 @@ use crate::fields::{Ctx, Result, SpanIndex};
 
 /// The shipped AMRU5 description (`robots/amru5.toml`), embedded at compile time.
 pub const AMRU5_TOML: &str = include_str!("../../../../robots/amru5.toml");
+
+/// The shipped PhantomX Mark II description (`robots/phantomx/phantomx.toml`), embedded.
+pub const PHANTOMX_TOML: &str = include_str!("../../../../robots/phantomx/phantomx.toml");
+
+/// The robots a scenario names by `scenario.robot = "<name>"`: name, embedded text, the file it
+/// was embedded from (named in errors).
+pub const SHIPPED_ROBOTS: [(&str, &str, &str); 2] = [("amru5", AMRU5_TOML, AMRU5_ORIGIN), ("phantomx", PHANTOMX_TOML, "robots/phantomx/phantomx.toml")];
 
 /// Name used in error messages for the embedded file, and the reference for the required
 /// fields of any description.

@@ -5,7 +5,7 @@
 use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
-use crate::hexapod::{PantographJoint, LEG_COUNT};
+use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
 use crate::physics::{DryViscous, LoadDependence};
 
 impl MotorTable {
@@ -168,6 +168,11 @@ impl RobotDescription {
             PantographJoint::Vertical => (r.q_v_m.min, r.q_v_m.max),
             PantographJoint::Horizontal => (r.q_h_m.min, r.q_h_m.max),
         }
+    }
+
+    /// PI gains of each joint k = 3 leg + j in SI (Table 4.1).
+    pub fn joint_pi_gains(&self) -> [PiGains; JOINTS] {
+        std::array::from_fn(|k| self.pi_gains(PantographJoint::ALL[k % 3]))
     }
 
     /// PI gains of a joint in SI (Table 4.1).

@@ -245,8 +245,9 @@ pub fn serial_hexapod_from_urdf(text: &str, file: &str) -> Result<SerialHexapod,
     if base.exits.len() != LEG_COUNT {
         return Err(r.err(format!("link \"{root}\" (the base, with the links fixed to it)"), format!("{} actuated joints leave it", base.exits.len()), "six: the first joint of each leg"));
     }
-    let mut legs = base.exits.iter().map(|(j, origin)| r.leg(j, *origin)).collect::<Result<Vec<_>, _>>()?;
-    number_legs(&r, &mut legs)?;
+    let legs = base.exits.iter().map(|(j, origin)| r.leg(j, *origin)).collect::<Result<Vec<_>, _>>()?;
+    let mut legs: [SerialLeg; LEG_COUNT] = legs.try_into().map_err(|_| r.err("robot", "not six legs", "six legs"))?;
+    number_serial_legs(&mut legs).map_err(|problem| r.err("robot", problem, "three legs on each side of the base's x axis"))?;
     for (l, leg) in legs.iter().enumerate() {
         for k in 0..3 {
             let (kind, first) = (leg.joints[k].kind, legs[0].joints[k].kind);
@@ -255,7 +256,7 @@ pub fn serial_hexapod_from_urdf(text: &str, file: &str) -> Result<SerialHexapod,
             }
         }
     }
-    Ok(SerialHexapod { name: robot.name.clone(), base: base.inertia, legs: legs.try_into().map_err(|_| r.err("robot", "not six legs", "six legs"))? })
+    Ok(SerialHexapod { name: robot.name.clone(), base: base.inertia, legs })
 }
 
 /// Every number the model uses is finite (and a sphere's radius positive), so that nothing
@@ -289,19 +290,20 @@ fn check_numbers(r: &Reader, robot: &urdf_rs::Robot) -> Result<(), UrdfError> {
 }
 
 /// Sorts the legs into the thesis numbering: the left ones (y > 0 at the first joint) 0, 2, 4
-/// and the right ones 1, 3, 5, each side from front to rear (x decreasing).
-fn number_legs(r: &Reader, legs: &mut Vec<SerialLeg>) -> Result<(), UrdfError> {
+/// and the right ones 1, 3, 5, each side from front to rear (x decreasing). The problem, when
+/// the mounts are not three on each side.
+pub(crate) fn number_serial_legs(legs: &mut [SerialLeg; LEG_COUNT]) -> Result<(), String> {
     let mount = |l: &SerialLeg| l.joints[0].origin.translation;
-    let (mut left, mut right): (Vec<SerialLeg>, Vec<SerialLeg>) = legs.drain(..).partition(|l| mount(l).y > 0.0);
+    let (mut left, mut right): (Vec<SerialLeg>, Vec<SerialLeg>) = legs.iter().cloned().partition(|l| mount(l).y > 0.0);
     if left.len() != 3 {
-        return Err(r.err("robot", format!("{} legs mounted on the left (y > 0 at their first joint), {} on the right", left.len(), right.len()), "three legs on each side of the base's x axis"));
+        return Err(format!("{} legs mounted on the left (y > 0 at their first joint), {} on the right", left.len(), right.len()));
     }
     for side in [&mut left, &mut right] {
         side.sort_by(|a, b| mount(b).x.total_cmp(&mount(a).x));
     }
-    for (l, r) in left.into_iter().zip(right) {
-        legs.push(l);
-        legs.push(r);
+    for (n, (l, r)) in left.into_iter().zip(right).enumerate() {
+        legs[2 * n] = l;
+        legs[2 * n + 1] = r;
     }
     Ok(())
 }

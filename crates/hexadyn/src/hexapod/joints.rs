@@ -10,7 +10,8 @@
 use std::fmt;
 
 /// What a joint's coordinate measures, which fixes its units.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum JointKind {
     /// An angle (rad); its effort is a torque (Nm).
     Revolute,

@@ -23,10 +23,10 @@ pub mod workspace;
 
 pub use joints::{JointKind, JointNameError, LegJoints};
 pub use leg_dynamics::{joint_torques, leg_joint_torques, StillBody};
-pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, Leg, LegChain, LegKinematics, LegKinematicsError, Limit, SerialLegKinematics};
+pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, Leg, LegChain, LegKinematics, LegKinematicsError, Limit, SerialLegKinematics, default_serial_height};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::{PantographGeometry, PantographJoint};
-pub use serial::{Link, SerialHexapod, SerialJoint, SerialLeg, SerialMechanics};
+pub use serial::{Link, Rotor, SerialHexapod, SerialJoint, SerialLeg, SerialMechanics};
 pub use workspace::Workspace;
 
 /// Number of legs of a hexapod; every per-leg array has this length.

@@ -74,7 +74,29 @@ pub struct SerialHexapod {
     pub legs: [SerialLeg; LEG_COUNT],
 }
 
-/// The multibody model of a serial hexapod: 1 + 18 bodies on the 24 coordinates of Eq. 3.51.
+/// A motor rotor turning at n q about its joint's axis, on the link that carries the motor
+/// (Eq. 3.69-3.71 for AMRU5's rotors): `inertia` about its axis (kg m²), `ratio` n.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rotor {
+    pub inertia: f64,
+    pub ratio: f64,
+}
+
+impl Rotor {
+    /// No rotor (the URDF's links alone).
+    pub const NONE: Rotor = Rotor { inertia: 0.0, ratio: 0.0 };
+
+    /// The rotor's inertia tensor in its frame, the axis `a` its spin axis. INTERPRETATION: the
+    /// equatorial moments are half the axial one (a thin disc); they enter only through the
+    /// links' rotations, small beside n² times the axial one.
+    fn tensor(&self, a: &Vector3<f64>) -> Matrix3<f64> {
+        let axial = a * a.transpose();
+        self.inertia * axial + 0.5 * self.inertia * (Matrix3::identity() - axial)
+    }
+}
+
+/// The multibody model of a serial hexapod: 1 + 18 bodies on the 24 coordinates of Eq. 3.51,
+/// and a massless rotor body per joint with a rotor inertia.
 #[derive(Clone, Debug)]
 pub struct SerialMechanics {
     pub model: Model,
@@ -90,6 +112,13 @@ impl SerialHexapod {
     /// Assembles the multibody model (Section 3.3.3): the base link as the free main body of
     /// Eq. 3.52, each link as a body on its joint's coordinate.
     pub fn mechanics(&self) -> Result<SerialMechanics, ModelError> {
+        self.mechanics_with(&[Rotor::NONE; 3])
+    }
+
+    /// [`Self::mechanics`] with the motor rotor of each joint of a leg: a body on the joint's
+    /// parent link, at the joint's frame, turning at n q about its axis (a configuration
+    /// parameter of Section 3.3.4, like AMRU5's rotors); its mass is in the link's.
+    pub fn mechanics_with(&self, rotors: &[Rotor; 3]) -> Result<SerialMechanics, ModelError> {
         let mut b = ModelBuilder::new(DOF);
         let mut base_joint = Elementary::free_body(0);
         base_joint.push(Elementary::offset(self.base.com.x, self.base.com.y, self.base.com.z));
@@ -105,6 +134,17 @@ impl SerialHexapod {
                     JointKind::Prismatic => Elementary::Translation { axis: joint.axis, var },
                 };
                 let back = -parent_com;
+                let rotor = &rotors[k];
+                if rotor.inertia > 0.0 {
+                    let spin = Var::q(joint_index(leg, k)).scaled(rotor.ratio);
+                    b.add_body(BodySpec {
+                        name: format!("leg{leg}.{}.rotor", joint.name),
+                        parent: Some(parent),
+                        joint: vec![Elementary::offset(back.x, back.y, back.z), Elementary::Fixed(joint.origin), Elementary::Rotation { axis: joint.axis, var: spin }],
+                        mass: 0.0,
+                        inertia: rotor.tensor(&joint.axis),
+                    })?;
+                }
                 let spec = BodySpec {
                     name: format!("leg{leg}.{}", joint.name),
                     parent: Some(parent),

@@ -108,6 +108,7 @@ impl Emulator {
     /// slave sockets, and starts answering.
     pub fn start(s: &Scenario, config: &LinkConfig, options: EmulatorOptions) -> Result<Emulator, LinkError> {
         options.faults.validate().map_err(LinkError::Emulator)?;
+        super::run::check_robot(s)?;
         let robot = settled_robot(s)?;
         let socket_error = |what, address: String| move |source| LinkError::Socket { what, address, source };
         let commands = UdpSocket::bind(config.broadcast).map_err(socket_error("cannot listen for the commands on", config.broadcast.to_string()))?;
@@ -130,7 +131,7 @@ impl Emulator {
             })
             .map_err(|e| LinkError::Emulator(format!("cannot start the sender thread: {e}")))?;
         let stop_model = stop.clone();
-        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: s.plant.encoder_counts, n: robot.robot.model.motors[k].n });
+        let encoders = robot.robot.model.encoders;
         let model = std::thread::Builder::new()
             .name("hexadyn-emulator".into())
             .spawn(move || {

@@ -60,9 +60,23 @@ pub struct RobotRun {
     pub events: Vec<LinkEvent>,
 }
 
-/// Checks that the scenario can run on the link: the same control period, and no navigation
-/// system (the robot has none, Section 2.3.2: level A is not implemented).
+/// The link carries AMRU5's slave boards: a pantograph robot's scenario only.
+pub(crate) fn check_robot(s: &Scenario) -> Result<(), LinkError> {
+    if s.robot.pantograph().is_none() {
+        return Err(LinkError::Mismatch(format!(
+            "{}: scenario.robot = {}: a {} robot; allowed: a pantograph robot (the link protocol of docs/protocol.md carries AMRU5's slave boards: motor voltages out, motor encoder counts in)",
+            s.origin,
+            s.robot_source,
+            s.robot.leg_mechanism()
+        )));
+    }
+    Ok(())
+}
+
+/// Checks that the scenario can run on the link: a pantograph robot, the same control period,
+/// and no navigation system (the robot has none, Section 2.3.2: level A is not implemented).
 pub fn check(s: &Scenario, config: &LinkConfig) -> Result<(), LinkError> {
+    check_robot(s)?;
     let link = config.timing.period.as_secs_f64();
     if (link - s.period()).abs() > 1e-9 * s.period() {
         return Err(LinkError::Mismatch(format!(
@@ -141,9 +155,10 @@ fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interru
     let mut controller = ScenarioController::new(s);
     let gait = controller.gait_columns();
     let pi = s.control.tracks_references();
-    let resistance = s.robot.circuit_resistance_ohm();
-    let mut row = Row { rec: Recorder::default(), joints: s.robot.joints.names.clone(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
-    let mut plant = UdpPlant::connect(config, &s.robot, interrupt)?;
+    let d = s.robot.pantograph().expect("checked: a pantograph robot");
+    let resistance = d.circuit_resistance_ohm();
+    let mut row = Row { rec: Recorder::default(), joints: d.joints.names.clone(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
+    let mut plant = UdpPlant::connect(config, d, interrupt)?;
     // As many controller updates as in a simulation: the controllers count their updates (the
     // gait integrates its body reference by Δt per update), so a missed period, which runs no
     // update, lengthens the run by one period.

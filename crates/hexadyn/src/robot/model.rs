@@ -22,7 +22,7 @@ use crate::mbs::{self, BodyId, Data};
 use crate::physics::{ContactForce, GroundContact, Proximity, Terrain, Vicinity};
 use crate::physics::{FrictionElement, JointFriction};
 use crate::physics::{limit_switch, saturate, DcMotor};
-use crate::control::{Command, ContinuousPid};
+use crate::control::{Command, ContinuousPid, Encoder, PositionServo};
 use crate::sim::{zero_matrix, Jacobian, Layout, Order, System};
 
 mod parts;
@@ -130,6 +130,11 @@ pub struct RobotModel {
     pub terrain: Arc<dyn Terrain>,
     /// Continuous joint controllers (Eq. 3.96-3.97), with [`JointControl::ContinuousPid`].
     pub pids: Option<[ContinuousPid; JOINTS]>,
+    /// The position sensor of each joint.
+    pub encoders: [Encoder; JOINTS],
+    /// Position servos ([`PositionServo`]): the motors are driven by the servos' own loops and
+    /// the model's inputs are the goal positions.
+    pub servos: Option<[PositionServo; JOINTS]>,
     layout: Layout,
     bristles: Option<usize>,
     currents: Option<usize>,
@@ -147,7 +152,8 @@ impl RobotModel {
     /// scales by their kind: 1e-5 rad, 1e-7 m), the bristle, current and PID states the options
     /// ask for.
     pub fn assemble(parts: RobotParts, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
-        let RobotParts { multibody, feet, joints, mut motors, friction, strokes, pi_gains } = parts;
+        let RobotParts { multibody, feet, joints, mut motors, friction, strokes, pi_gains, encoders, servos } = parts;
+        assert!(servos.is_none() || options.control == JointControl::Digital, "position servos run their own loops: no continuous PID on them");
         for motor in &mut motors {
             motor.inductance = options.inductance;
         }
@@ -191,7 +197,7 @@ impl RobotModel {
             }
             first
         });
-        RobotModel { multibody, feet, joints, motors, friction, strokes, options, terrain, pids, layout, bristles, currents, pid }
+        RobotModel { multibody, feet, joints, motors, friction, strokes, options, terrain, pids, encoders, servos, layout, bristles, currents, pid }
     }
 
     /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance,
@@ -206,6 +212,12 @@ impl RobotModel {
     /// Index of the current state of joint k, if any.
     pub fn current_index(&self, k: usize) -> Option<usize> {
         self.currents.map(|c| c + k)
+    }
+
+    /// Whether the model's inputs are joint references (continuous PID controllers or position
+    /// servos) rather than motor voltages.
+    pub fn takes_references(&self) -> bool {
+        self.pids.is_some() || self.servos.is_some()
     }
 
     /// Initial q for the given joint positions: body at (0, 0, Z) with zero yaw, parallel to the
@@ -417,13 +429,12 @@ impl Robot {
     /// (Section 2.3.1), read at the control instant as the slave boards apply the commands.
     /// Continuous PID control: the references.
     pub fn command(&mut self, command: &Command, q: &[f64]) {
-        match self.model.pids {
-            None => {
-                for k in 0..JOINTS {
-                    self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k]);
-                }
+        if self.model.takes_references() {
+            self.references = command.references;
+        } else {
+            for k in 0..JOINTS {
+                self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k]);
             }
-            Some(_) => self.references = command.references,
         }
     }
 
@@ -439,7 +450,7 @@ impl Robot {
             let proximity = m.terrain.proximity_near(&position, m.options.ground.foot_radius, &mut self.vicinity[leg]);
             Foot { position, velocity, proximity }
         });
-        self.force_laws(qd, qdd, &feet);
+        self.force_laws(q, qd, qdd, &feet);
         self.feet = Some(feet);
         self.data.clear_forces();
         for (leg, (body, _)) in self.model.feet.iter().enumerate() {
@@ -454,8 +465,8 @@ impl Robot {
     }
 
     /// Contact forces at the feet and motor and friction torques of the joints at the given foot
-    /// states and (q', q''), into [`Self::outputs`].
-    fn force_laws(&mut self, qd: &[f64], qdd: &[f64], feet: &[Foot; 6]) {
+    /// states and (q, q', q''), into [`Self::outputs`].
+    fn force_laws(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], feet: &[Foot; 6]) {
         let m = &*self.model;
         let out = &mut self.outputs;
         // Ground contact at the feet (Eq. 3.72-3.73).
@@ -471,7 +482,11 @@ impl Robot {
         for k in 0..JOINTS {
             let j = 6 + k;
             let motor = &m.motors[k];
-            let commanded = m.pid.map_or(self.voltages[k], |p| qd[p + 2 * k]);
+            let commanded = match (m.pid, &m.servos) {
+                (Some(p), _) => qd[p + 2 * k],
+                (None, Some(servos)) => servos[k].voltage(self.references[k], q[j], m.options.supply_voltage).u,
+                (None, None) => self.voltages[k],
+            };
             let u = saturate(commanded, m.options.supply_voltage);
             let i = match m.currents {
                 Some(c) => qd[c + k],
@@ -637,6 +652,14 @@ impl System for Robot {
             let motor = &m.motors[k];
             let dtau_m = if m.currents.is_some() { 0.0 } else { motor.joint_torque(motor.current(qd[j], 0.0).di_dqd).0 };
             jac.ct[(j, j)] += t.dtau_dqd - dtau_m;
+            if let Some(servos) = &m.servos {
+                // The servo's voltage u(q_d − q_j) drives the motor (f_j contains −τ_m(u)).
+                let du_dq = servos[k].voltage(self.references[k], q[j], m.options.supply_voltage).du_dq;
+                match m.currents {
+                    Some(c) => jac.kt[(c + k, j)] = -du_dq,
+                    None => jac.kt[(j, j)] -= motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * du_dq,
+                }
+            }
             for col in 0..DOF {
                 jac.kt[(j, col)] += t.dtau_dload * dfn_dq[leg][col];
                 jac.ct[(j, col)] += t.dtau_dload * dfn_dqd[leg][col];
@@ -708,15 +731,17 @@ impl System for Robot {
         JOINTS
     }
     fn input(&self, k: usize) -> f64 {
-        match self.model.pids {
-            None => self.voltages[k],
-            Some(_) => self.references[k],
+        if self.model.takes_references() {
+            self.references[k]
+        } else {
+            self.voltages[k]
         }
     }
     fn set_input(&mut self, k: usize, value: f64) {
-        match self.model.pids {
-            None => self.voltages[k] = value,
-            Some(_) => self.references[k] = value,
+        if self.model.takes_references() {
+            self.references[k] = value;
+        } else {
+            self.voltages[k] = value;
         }
     }
 
@@ -725,8 +750,9 @@ impl System for Robot {
     /// commanded, [`Robot::command`]) through the current of Eq. 4.4 into the joint row
     /// (f_j contains −n k_t i) or, with inductance, into the current row of Eq. 3.91 (−u); a
     /// reference q_d of a continuous PID through its error ε = q_d − q_j into the integral row
-    /// of Eq. 3.97.
-    fn input_change(&mut self, _t: f64, _q: &[f64], qd: &[f64], qdd: &[f64], previous: &[f64], df: &mut [f64]) -> bool {
+    /// of Eq. 3.97; a goal of a position servo through the servo's voltage (not affinely: the
+    /// change of the voltage between the two goals at the same q).
+    fn input_change(&mut self, _t: f64, q: &[f64], qd: &[f64], qdd: &[f64], previous: &[f64], df: &mut [f64]) -> bool {
         if previous.len() != JOINTS || df.len() != self.model.layout.len() {
             return false;
         }
@@ -741,7 +767,11 @@ impl System for Robot {
                 }
                 _ => {
                     let motor = &m.motors[k];
-                    let du = saturate(self.voltages[k], m.options.supply_voltage) - saturate(previous[k], m.options.supply_voltage);
+                    let supply = m.options.supply_voltage;
+                    let du = match &m.servos {
+                        Some(servos) => servos[k].voltage(self.references[k], q[j], supply).u - servos[k].voltage(previous[k], q[j], supply).u,
+                        None => saturate(self.voltages[k], supply) - saturate(previous[k], supply),
+                    };
                     match m.currents {
                         Some(c) => df[c + k] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], 0.0).df_du * du,
                         None => df[j] = -motor.joint_torque(motor.current(qd[j], 0.0).di_du * du).0,

@@ -7,7 +7,6 @@ use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use super::model::{FrictionModel, ModelOptions, Robot, RobotModel};
-use crate::description::RobotDescription;
 use crate::control::{BodyPose, Command, Controller, Encoder, Measurements, Plant};
 use crate::hexapod::JOINTS;
 use crate::mbs;
@@ -117,8 +116,6 @@ pub struct PlantOptions {
     pub integrator: NewmarkOptions,
     /// Control period Δt (s), 10 ms on AMRU5.
     pub period: f64,
-    /// Encoder impulses per motor revolution.
-    pub encoder_counts: u32,
     /// Whether the controller receives the true body pose (navigation system, Section 7.4).
     pub navigation: bool,
     /// The current sensors (Section 5.6.2): analog filter cut-off, noise and its seed.
@@ -126,8 +123,8 @@ pub struct PlantOptions {
 }
 
 impl PlantOptions {
-    /// The control period and encoders of the description, and the integrator for the model.
-    pub fn from_description(d: &RobotDescription, model: &ModelOptions) -> Self {
+    /// The control period `period` (s) and the integrator for the model.
+    pub fn new(period: f64, model: &ModelOptions) -> Self {
         // Modified Newton refreshes the Jacobian when a correction shrinks by less than this
         // factor. With LuGre the iteration matrix has 42 rows instead of 24, and a Jacobian and
         // its LU cost several residual evaluations more, so the stale one is kept longer
@@ -153,9 +150,8 @@ impl PlantOptions {
         // least every 90 ms of walking.
         let unverified_steps = 8;
         PlantOptions {
-            integrator: NewmarkOptions { tolerance: 1.0, h_max: d.controller.period_s, h_initial: 1e-4, slow_contraction, gamma: 0.6, beta: 0.3025, surrogate_iterations, unverified_steps, ..Default::default() },
-            period: d.controller.period_s,
-            encoder_counts: d.controller.encoder_impulses_per_rev,
+            integrator: NewmarkOptions { tolerance: 1.0, h_max: period, h_initial: 1e-4, slow_contraction, gamma: 0.6, beta: 0.3025, surrogate_iterations, unverified_steps, ..Default::default() },
+            period,
             navigation: false,
             current_sensing: CurrentSensing::default(),
         }
@@ -183,7 +179,7 @@ impl SimulatedRobot {
     pub fn new(model: Arc<RobotModel>, q: &[f64], qd: &[f64], options: &PlantOptions) -> Result<Self, SimError> {
         let mut robot = Robot::new(model);
         let integrator = Newmark::new(&mut robot, 0.0, q, qd, options.integrator.clone())?;
-        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: options.encoder_counts, n: robot.model.motors[k].n });
+        let encoders = robot.model.encoders;
         let current_sensors = CurrentSensors::new(&options.current_sensing, 0.0, &[0.0; JOINTS]);
         let consistent_inputs = std::array::from_fn(|k| robot.input(k));
         let mut plant = SimulatedRobot { robot, integrator, energy: EnergyAccount::default(), initial_energy: EnergyAccount::default(), consistent_inputs, encoders, current_sensors, period: options.period, navigation: options.navigation };

@@ -16,11 +16,12 @@ use super::joint_friction::RawJointFriction;
 use super::terrain::{self, RawTerrain};
 use super::{ControlMode, Initial, ModelFlags, Motion, Result, Scenario, ScenarioError, DEFAULT_ROBOT};
 use crate::control::{GroundExperiment, JointMotion};
-use crate::description::{RobotDescription, AMRU5_TOML};
+use crate::description::{Robot, RobotDescription, AMRU5_TOML, SHIPPED_ROBOTS};
 use crate::fields::{Ctx, DescriptionError};
-use crate::hexapod::{PantographJoint, JOINTS};
+use crate::description::SerialRobot;
+use crate::hexapod::{default_serial_height, Leg, PantographJoint, SerialLegKinematics, JOINTS};
 use crate::physics::LOAD_GRAVITY;
-use crate::robot::model::{FrictionModel, ModelOptions};
+use crate::robot::model::FrictionModel;
 use crate::robot::simulation::PlantOptions;
 
 // =============================================================================================
@@ -126,6 +127,8 @@ struct RawIntegrator {
 #[serde(deny_unknown_fields)]
 struct RawInitial {
     // The joint fields are options so that gait mode can reject them when written.
+    /// Serial legs: the body height the feet stand at the centre of their workspaces (m).
+    body_height_m: Option<f64>,
     q_r_deg: Option<f64>,
     q_v_m: Option<f64>,
     q_h_m: Option<f64>,
@@ -153,7 +156,7 @@ fn default_true() -> bool {
 
 impl Default for RawInitial {
     fn default() -> Self {
-        RawInitial { q_r_deg: None, q_v_m: None, q_h_m: None, lifted_legs: None, q_v_lifted_m: None, settle: true, body_height_offset_m: 0.0 }
+        RawInitial { body_height_m: None, q_r_deg: None, q_v_m: None, q_h_m: None, lifted_legs: None, q_v_lifted_m: None, settle: true, body_height_offset_m: 0.0 }
     }
 }
 
@@ -252,8 +255,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
 
     // The robot first: the strokes and the control period bound the other fields.
+    let shipped = SHIPPED_ROBOTS.iter().find(|(name, _, _)| *name == h.robot);
     let (mut robot, robot_source, robot_text) = if h.robot == DEFAULT_ROBOT {
-        (RobotDescription::amru5(), DEFAULT_ROBOT.to_string(), AMRU5_TOML.to_string())
+        (Robot::Pantograph(RobotDescription::amru5()), DEFAULT_ROBOT.to_string(), AMRU5_TOML.to_string())
+    } else if let Some((name, text, origin)) = shipped {
+        (Robot::from_str(text, origin).map_err(ScenarioError::Robot)?, name.to_string(), text.to_string())
     } else {
         let path: PathBuf = if Path::new(&h.robot).is_absolute() { PathBuf::from(&h.robot) } else { dir.join(&h.robot) };
         let shown = path.display().to_string();
@@ -262,19 +268,29 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
                 "scenario.robot",
                 format!("{:?}", h.robot),
                 &format!("cannot read {shown}: {err}"),
-                format!("\"{DEFAULT_ROBOT}\" (the embedded AMRU5 description) or the path of a robot description file, relative to the scenario file"),
+                format!("a shipped robot ({}) or the path of a robot description file, relative to the scenario file", SHIPPED_ROBOTS.map(|(name, _, _)| format!("\"{name}\"")).join(", ")),
             ))
         })?;
-        let robot = RobotDescription::from_str(&text, &shown).map_err(ScenarioError::Robot)?;
+        let robot = Robot::from_str(&text, &shown).map_err(ScenarioError::Robot)?;
         (robot, shown, text)
     };
-    let period = robot.controller.period_s;
+    let period = robot.period();
     c.check(h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a duration >= {period} s (one control period)")).map_err(e)?;
 
     // Model.
     let m = &raw.model;
-    m.joint_friction.apply(c, &mut robot).map_err(e)?;
-    let mut model = ModelOptions::from_description(&robot, m.friction);
+    match &mut robot {
+        Robot::Pantograph(d) => m.joint_friction.apply(c, d).map_err(e)?,
+        Robot::Serial(_) => {
+            if !m.joint_friction.is_empty() {
+                return Err(e(c.err("model.joint_friction", "[model.joint_friction]", "a pantograph table on serial legs", "no [model.joint_friction] with a serial robot: its friction is in [drives.<joint>.friction] of its description")));
+            }
+            if m.load_dependence {
+                return Err(e(c.err("model.load_dependence", "true", "no load dependence on serial legs", "false with a serial robot (Eq. 5.12 is identified on AMRU5's horizontal joints)")));
+            }
+        }
+    }
+    let mut model = robot.model_options(m.friction);
     if m.load_dependence && m.friction == FrictionModel::None {
         return Err(e(c.err("model.load_dependence", "true", "needs joint friction", "false with friction = \"none\" (or friction = \"dry_viscous\" or \"lugre\")")));
     }
@@ -299,7 +315,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
     let terrain = terrain::validate(raw.terrain.as_ref(), c, dir).map_err(e)?;
     if let Some(v) = m.supply_voltage_v {
-        let rated = robot.motor.nominal_voltage_v;
+        let rated = robot.nominal_voltage();
         in_range(c, "model.supply_voltage_v", v, [SUPPLY_MIN_V, 2.0 * rated], "V", &format!("up to twice the motors' nominal voltage ({rated} V): the motor model has no limit beyond it"))?;
         model.supply_voltage = v;
     }
@@ -316,7 +332,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     }
 
     // Integrator.
-    let mut plant = PlantOptions::from_description(&robot, &model);
+    let mut plant = PlantOptions::new(period, &model);
     if let Some(v) = raw.integrator.tolerance {
         in_range(c, "integrator.tolerance", v, TOLERANCE_RANGE, "", "the error estimate of Eq. 3.15 in units of the layout scales (the robot's is 1; 1e3 already leaves a 13 % energy balance error; 1e-4 takes 5 times the robot's steps for a balance error below 0.01 %, tighter only costs time)")?;
         plant.integrator.tolerance = v;
@@ -361,7 +377,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     // Initial configuration.
     let i = &raw.initial;
     if gait.is_some() {
-        let written = [("q_r_deg", i.q_r_deg.map(|v| v.to_string())), ("q_v_m", i.q_v_m.map(|v| v.to_string())), ("q_h_m", i.q_h_m.map(|v| v.to_string())), ("lifted_legs", i.lifted_legs.as_ref().map(|v| format!("{v:?}"))), ("q_v_lifted_m", i.q_v_lifted_m.map(|v| v.to_string()))];
+        let written = [("body_height_m", i.body_height_m.map(|v| v.to_string())), ("q_r_deg", i.q_r_deg.map(|v| v.to_string())), ("q_v_m", i.q_v_m.map(|v| v.to_string())), ("q_h_m", i.q_h_m.map(|v| v.to_string())), ("lifted_legs", i.lifted_legs.as_ref().map(|v| format!("{v:?}"))), ("q_v_lifted_m", i.q_v_lifted_m.map(|v| v.to_string()))];
         if let Some((name, Some(value))) = written.into_iter().find(|(_, v)| v.is_some()) {
             return Err(e(c.err(
                 &format!("initial.{name}"),
@@ -371,39 +387,10 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
             )));
         }
     }
-    let (q_r_deg, q_v_m, q_h_m, q_v_lifted_m) = (i.q_r_deg.unwrap_or(0.0), i.q_v_m.unwrap_or_else(default_q_v), i.q_h_m.unwrap_or_else(default_q_h), i.q_v_lifted_m.unwrap_or_else(default_q_v_lifted));
-    let range = |j: PantographJoint| robot.joint_range(j);
-    let stroke = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str, what: &str| {
-        c.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}] {unit} ({what} of the robot description, joint_ranges)"))
+    let (posture, lifted) = match &robot {
+        Robot::Pantograph(d) => pantograph_initial(i, c, d).map_err(e)?,
+        Robot::Serial(s) => (serial_initial(i, c, s).map_err(e)?, Vec::new()),
     };
-    let r = &robot.joint_ranges.q_r_deg;
-    stroke("initial.q_r_deg", q_r_deg, (r.min, r.max), "deg", "the q_r range").map_err(e)?;
-    stroke("initial.q_v_m", q_v_m, range(PantographJoint::Vertical), "m", "the q_v stroke").map_err(e)?;
-    stroke("initial.q_h_m", q_h_m, range(PantographJoint::Horizontal), "m", "the q_h stroke").map_err(e)?;
-    let mut lifted = Vec::new();
-    for (n, &leg) in i.lifted_legs.iter().flatten().enumerate() {
-        let field = format!("initial.lifted_legs[{n}]");
-        if !(0..6).contains(&leg) {
-            return Err(e(c.err(&field, leg, "no such leg", "a leg number 0..5")));
-        }
-        let leg = leg as usize;
-        if lifted.contains(&leg) {
-            return Err(e(c.err(&field, leg, "listed twice", "each leg at most once")));
-        }
-        lifted.push(leg);
-    }
-    lifted.sort_unstable();
-    if !lifted.is_empty() {
-        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(PantographJoint::Vertical), "m", "the q_v stroke").map_err(e)?;
-        if q_v_lifted_m >= q_v_m {
-            return Err(e(c.err(
-                "initial.q_v_lifted_m",
-                q_v_lifted_m,
-                "does not lift the foot",
-                format!("a value < initial.q_v_m = {q_v_m} (a smaller q_v lifts the foot, z_foot ~ -6 q_v)"),
-            )));
-        }
-    }
     if i.settle && lifted.len() > 3 {
         return Err(e(c.err(
             "initial.lifted_legs",
@@ -415,17 +402,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     c.check(i.body_height_offset_m >= 0.0, "initial.body_height_offset_m", i.body_height_offset_m, "a finite number >= 0 (m, added to the body height after settling)").map_err(e)?;
     let joints: [f64; JOINTS] = match &gait {
         Some(g) => g.joints,
-        None => std::array::from_fn(|k| match k % 3 {
-            0 => q_r_deg.to_radians(),
-            1 => {
-                if lifted.contains(&(k / 3)) {
-                    q_v_lifted_m
-                } else {
-                    q_v_m
-                }
-            }
-            _ => q_h_m,
-        }),
+        None => posture,
     };
     let initial = Initial { joints, lifted_legs: lifted, settle: i.settle, body_height_offset: i.body_height_offset_m };
 
@@ -443,14 +420,19 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     for (n, rm) in raw.control.motion.iter().enumerate() {
         let motion = validate_motion(rm, &format!("control.motion[{n}]"), c, &robot, &joints, h.duration_s).map_err(e)?;
         if !seen.insert(motion.joint_index()) {
-            let name = robot.joints.names.name(motion.joint);
+            let name = robot.joints().name(motion.joint);
             return Err(e(c.err(&format!("control.motion[{n}].joint"), name, &format!("a second motion of leg {}'s {name}", motion.leg), "one motion per (leg, joint)")));
         }
         motions.push(motion);
     }
 
     let ground_detection = match (mode, &raw.ground_detection) {
-        (ControlMode::GroundDetection, Some(g)) => Some(validate_ground_detection(g, c, &robot, &initial).map_err(e)?),
+        (ControlMode::GroundDetection, Some(g)) => {
+            let Robot::Pantograph(d) = &robot else {
+                return Err(e(c.err("control.mode", "\"ground_detection\"", "not available on serial legs yet", "pi, unpowered or gait with a serial robot (the experiment of Section 5.6.3 is written for the pantograph's vertical joint)")));
+            };
+            Some(validate_ground_detection(g, c, d, &initial).map_err(e)?)
+        }
         (ControlMode::GroundDetection, None) => {
             return Err(e(c.err("ground_detection", "<missing>", "missing table", "a [ground_detection] table with control.mode = \"ground_detection\" (see python/hexadyn/scenarios/ground_detection.toml)")));
         }
@@ -480,16 +462,93 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     })
 }
 
-fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription, joints: &[f64; JOINTS], duration: f64) -> std::result::Result<Motion, DescriptionError> {
+/// The initial joints of a pantograph robot (`q_r_deg`, `q_v_m`, `q_h_m`, the lifted legs at
+/// `q_v_lifted_m`), each within its stroke, and the lifted legs.
+fn pantograph_initial(i: &RawInitial, c: &Ctx, robot: &RobotDescription) -> std::result::Result<([f64; JOINTS], Vec<usize>), DescriptionError> {
+    if let Some(v) = i.body_height_m {
+        return Err(c.err("initial.body_height_m", v, "a serial robot's key", "q_r_deg, q_v_m, q_h_m (and lifted_legs, q_v_lifted_m) for the pantograph legs of this robot"));
+    }
+    let (q_r_deg, q_v_m, q_h_m, q_v_lifted_m) = (i.q_r_deg.unwrap_or(0.0), i.q_v_m.unwrap_or_else(default_q_v), i.q_h_m.unwrap_or_else(default_q_h), i.q_v_lifted_m.unwrap_or_else(default_q_v_lifted));
+    let range = |j: PantographJoint| robot.joint_range(j);
+    let stroke = |field: &str, v: f64, (lo, hi): (f64, f64), unit: &str, what: &str| {
+        c.check(v >= lo && v <= hi, field, v, &format!("a finite number in [{lo}, {hi}] {unit} ({what} of the robot description, joint_ranges)"))
+    };
+    let r = &robot.joint_ranges.q_r_deg;
+    stroke("initial.q_r_deg", q_r_deg, (r.min, r.max), "deg", "the q_r range")?;
+    stroke("initial.q_v_m", q_v_m, range(PantographJoint::Vertical), "m", "the q_v stroke")?;
+    stroke("initial.q_h_m", q_h_m, range(PantographJoint::Horizontal), "m", "the q_h stroke")?;
+    let mut lifted = Vec::new();
+    for (n, &leg) in i.lifted_legs.iter().flatten().enumerate() {
+        let field = format!("initial.lifted_legs[{n}]");
+        if !(0..6).contains(&leg) {
+            return Err(c.err(&field, leg, "no such leg", "a leg number 0..5"));
+        }
+        let leg = leg as usize;
+        if lifted.contains(&leg) {
+            return Err(c.err(&field, leg, "listed twice", "each leg at most once"));
+        }
+        lifted.push(leg);
+    }
+    lifted.sort_unstable();
+    if !lifted.is_empty() {
+        stroke("initial.q_v_lifted_m", q_v_lifted_m, range(PantographJoint::Vertical), "m", "the q_v stroke")?;
+        if q_v_lifted_m >= q_v_m {
+            return Err(c.err("initial.q_v_lifted_m", q_v_lifted_m, "does not lift the foot", format!("a value < initial.q_v_m = {q_v_m} (a smaller q_v lifts the foot, z_foot ~ -6 q_v)")));
+        }
+    }
+    let joints = std::array::from_fn(|k| match k % 3 {
+        0 => q_r_deg.to_radians(),
+        1 => {
+            if lifted.contains(&(k / 3)) {
+                q_v_lifted_m
+            } else {
+                q_v_m
+            }
+        }
+        _ => q_h_m,
+    });
+    Ok((joints, lifted))
+}
+
+/// The initial joints of a serial robot: every foot at the centre of its workspace cylinder
+/// (Section 7.1.1) at `initial.body_height_m` below the body (default: the mean height of the
+/// feet with every joint at mid-range).
+fn serial_initial(i: &RawInitial, c: &Ctx, robot: &SerialRobot) -> std::result::Result<[f64; JOINTS], DescriptionError> {
+    let written = [("q_r_deg", i.q_r_deg), ("q_v_m", i.q_v_m), ("q_h_m", i.q_h_m), ("q_v_lifted_m", i.q_v_lifted_m)];
+    if let Some((name, Some(v))) = written.into_iter().find(|(_, v)| v.is_some()) {
+        return Err(c.err(&format!("initial.{name}"), v, "a pantograph key on serial legs", "initial.body_height_m (m) for a serial robot: the feet stand at the centre of their workspaces"));
+    }
+    if let Some(legs) = &i.lifted_legs {
+        return Err(c.err("initial.lifted_legs", format!("{legs:?}"), "not available on serial legs yet", "no lifted_legs with a serial robot (every foot starts on the ground)"));
+    }
+    let legs = SerialLegKinematics::hexapod(&robot.hexapod.legs).map_err(|err| c.err("scenario.robot", robot.origin.clone(), &format!("no leg kinematics: {err}"), "serial legs with valid joint ranges"))?;
+    let height = match i.body_height_m {
+        Some(h) => h,
+        None => default_serial_height(&legs),
+    };
+    let mut joints = [0.0; JOINTS];
+    for (l, leg) in legs.iter().enumerate() {
+        let z = -height;
+        let reached = leg.workspace(z, z).ok().and_then(|w| leg.inverse(&w.centre_at(z), &leg.neutral()).ok()).filter(|s| s.is_reached());
+        let Some(s) = reached else {
+            let (lowest, highest) = leg.height_range();
+            return Err(c.err("initial.body_height_m", height, &format!("leg {l}'s foot cannot stand at this height"), format!("a body height in ({:.4}, {:.4}) m, where the feet reach the ground", -highest, -lowest)));
+        };
+        joints[3 * l..3 * l + 3].copy_from_slice(s.joints.as_slice());
+    }
+    Ok(joints)
+}
+
+fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &Robot, joints: &[f64; JOINTS], duration: f64) -> std::result::Result<Motion, DescriptionError> {
     let field = |name: &str| format!("{path}.{name}");
     if !(0..6).contains(&m.leg) {
         return Err(c.err(&field("leg"), m.leg, "no such leg", "a leg number 0..5"));
     }
     let leg = m.leg as usize;
-    let names = &robot.joints.names;
+    let names = robot.joints();
     let joint = names.position(&m.joint).ok_or_else(|| c.err(&field("joint"), format!("{:?}", m.joint), "no such joint", format!("one of the robot's joints: {}", names.names().collect::<Vec<_>>().join(", "))))?;
     let base = joints[3 * leg + joint];
-    let (lo, hi) = robot.joint_range(PantographJoint::ALL[joint]);
+    let (lo, hi) = robot.joint_range(3 * leg + joint);
     let tol = STROKE_TOLERANCE * (hi - lo);
     let unit = names.kind(joint).unit(("rad", "m"));
     let (kind, used): (&str, &[&str]) = match m.kind {
@@ -498,6 +557,11 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
         MotionKind::Sawtooth => ("sawtooth", &["min", "max", "speed", "speed_step", "speed_max"]),
         MotionKind::VoltageRamp => ("voltage_ramp", &["rate_v_per_s"]),
     };
+    if let (MotionKind::VoltageRamp, Robot::Serial(s)) = (m.kind, robot) {
+        if s.has_servos() {
+            return Err(c.err(&field("kind"), "\"voltage_ramp\"", "a voltage motion on position servos", "ramp, sine or sawtooth: the servos take goal positions, not voltages"));
+        }
+    }
     let fields = [
         ("rate", m.rate),
         ("start_s", m.start_s),
@@ -545,8 +609,8 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &RobotDescription,
             let frequency_hz = required("frequency_hz", m.frequency_hz)?;
             let max = (hi - base).min(base - lo);
             c.check(amplitude.abs() <= max + tol, &field("amplitude"), amplitude, &format!("|amplitude| <= {max:.6} {unit} so that the reference stays in {stroke_text}"))?;
-            let nyquist = 0.5 / robot.controller.period_s;
-            c.check(frequency_hz > 0.0 && frequency_hz < nyquist, &field("frequency_hz"), frequency_hz, &format!("a frequency in (0, {nyquist}) Hz, below the Nyquist frequency of the control period ({} s)", robot.controller.period_s))?;
+            let nyquist = 0.5 / robot.period();
+            c.check(frequency_hz > 0.0 && frequency_hz < nyquist, &field("frequency_hz"), frequency_hz, &format!("a frequency in (0, {nyquist}) Hz, below the Nyquist frequency of the control period ({} s)", robot.period()))?;
             JointMotion::Sine { amplitude, frequency_hz }
         }
         MotionKind::Sawtooth => {

@@ -19,9 +19,9 @@ use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, 
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
 use crate::control::{joint_pis, Controller};
-use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
-use crate::description::RobotDescription;
+use crate::description::{Robot, RobotDescription};
 
 type Result<T> = std::result::Result<T, DescriptionError>;
 
@@ -247,7 +247,7 @@ pub struct GaitScenario {
     pub navigation: bool,
     /// Height of the body frame above the ground the workspaces are computed for (m).
     pub body_height: f64,
-    pub legs: [LegKinematics; 6],
+    pub legs: GaitLegs,
     pub workspaces: [Workspace; 6],
     pub changes: Vec<GaitChange>,
     /// The initial posture: the steady footholds of the initial phases on the ground, by
@@ -255,24 +255,36 @@ pub struct GaitScenario {
     pub joints: [f64; JOINTS],
 }
 
+/// The legs a gait walks on: AMRU5's pantographs or serial chains. (Built once per scenario:
+/// the variants' sizes do not matter.)
+#[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+pub enum GaitLegs {
+    Pantograph([LegKinematics; 6]),
+    Serial([SerialLegKinematics; 6]),
+}
+
 impl GaitScenario {
     /// A fresh gait controller for a run (the periodic one with the scheduled gait changes, or
     /// the free gait) with the 18 PI loops of the robot, and the state it publishes after each
     /// update.
-    pub fn controller(&self, robot: &RobotDescription) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
-        let pis = joint_pis(robot, self.options.dt);
-        match &self.free {
-            Some(free) => {
-                let controller = FreeGaitController::new(free.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
+    pub fn controller(&self, robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let pis = joint_pis(&robot.pi_gains(), self.options.dt);
+        match (&self.free, &self.legs, robot) {
+            (Some(free), GaitLegs::Pantograph(legs), Robot::Pantograph(d)) => {
+                let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(d, self.options.dt));
                 let (c, state) = PublishedFreeGait::new(controller);
                 (Box::new(c), state)
             }
-            None => {
-                let controller = GaitController::new(self.options.clone(), self.legs.clone(), self.workspaces, pis, self.heading.source());
-                let (c, state) = ScheduledGait::new(controller, self.changes.clone());
-                (Box::new(c), state)
-            }
+            (Some(_), _, _) => unreachable!("the free gait is validated on pantograph legs only"),
+            (None, GaitLegs::Pantograph(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
+            (None, GaitLegs::Serial(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
         }
+    }
+
+    fn scheduled<L: Leg + Clone + 'static>(&self, controller: GaitController<L>) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let (c, state) = ScheduledGait::new(controller, self.changes.clone());
+        (Box::new(c), state)
     }
 }
 
@@ -311,8 +323,8 @@ fn duty_factor(c: &Ctx, field: &str, kind: GaitKind, value: Option<f64>, cycle: 
 }
 
 /// Validates the `[gait]` table. `duration` is the scenario's (s).
-pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Path, duration: f64) -> Result<GaitScenario> {
-    let dt = robot.controller.period_s;
+pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
+    let dt = robot.period();
     let periodic = match g.pattern.periodic() {
         Some(kind) => Some(periodic_pattern(g, c, kind, dt, duration)?),
         None => {
@@ -326,22 +338,53 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
 
     let clearance = g.clearance_m.unwrap_or(DEFAULT_CLEARANCE);
     c.positive("gait.clearance_m", clearance)?;
+    let heading = || validate_heading(&g.heading, c, dir);
+    let no_kinematics = |e: LegKinematicsError, what: &str| c.err("scenario.robot", robot.origin(), &format!("no leg kinematics: {e}"), what);
 
-    // Leg kinematics and workspaces at the body height.
-    let legs = LegKinematics::hexapod_from_description(robot)
-        .map_err(|e| c.err("scenario.robot", &robot.origin, &format!("no leg kinematics: {e}"), "a robot description whose pantograph closes over the joint ranges"))?;
-    let height = match g.body_height_m {
-        Some(h) => h,
-        None => default_body_height(&legs),
-    };
-    let given = if g.body_height_m.is_some() { "" } else { " (the default, q_v = 0.06 m)" };
-    let (lowest, highest) = legs[0].height_range();
+    match robot {
+        Robot::Pantograph(d) => {
+            let legs = LegKinematics::hexapod_from_description(d).map_err(|e| no_kinematics(e, "a robot description whose pantograph closes over the joint ranges"))?;
+            let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
+            let heading = heading()?;
+            match periodic {
+                None => free_gait(g, c, heading, legs, stance, clearance, dt),
+                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration).map(|w| w.on(GaitLegs::Pantograph(legs), stance)),
+            }
+        }
+        Robot::Serial(s) => {
+            let legs = SerialLegKinematics::hexapod(&s.hexapod.legs).map_err(|e| no_kinematics(e, "serial legs with valid joint ranges"))?;
+            let stance = stance(g, c, &legs, default_serial_height(&legs), " (the default: the feet with every joint at mid-range)", clearance)?;
+            let heading = heading()?;
+            match periodic {
+                None => Err(c.err("gait.pattern", "\"free\"", "not available on serial legs yet", "tripod, wave or equal_phase with a serial robot (the free gait's landing and posture control are written for the pantograph)")),
+                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration).map(|w| w.on(GaitLegs::Serial(legs), stance)),
+            }
+        }
+    }
+}
+
+/// The body height of a gait and the workspace cylinders of the legs at it.
+struct Stance {
+    height: f64,
+    workspaces: [Workspace; 6],
+    /// What `gait.body_height_m` allows, for the errors.
+    reach: String,
+    /// " (the default ...)" when the height was not written.
+    given: &'static str,
+}
+
+/// The body height (`gait.body_height_m` or `default`) and the workspace of each leg for the
+/// foot heights from the ground to the clearance (Section 7.1.1).
+fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_text: &'static str, clearance: f64) -> Result<Stance> {
+    let height = g.body_height_m.unwrap_or(default);
+    let given = if g.body_height_m.is_some() { "" } else { default_text };
+    let (lowest, highest) = legs.iter().map(|l| l.height_range()).fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (l, h)| (lo.max(l), hi.min(h)));
     // The feet on the ground are at z = −height in the leg frame.
     let reach = format!("a body height in ({:.4}, {:.4}) m, where the feet reach the ground (foot heights [{:.4}, {:.4}] m in the leg frame)", -highest, -lowest, lowest, highest);
     if !(height.is_finite() && height > 0.0) {
         return Err(c.err("gait.body_height_m", height, "not a positive finite number", reach));
     }
-    for leg in &legs {
+    for leg in legs {
         if leg.workspace(-height, -height).is_err() {
             return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach));
         }
@@ -354,14 +397,14 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
             workspaces.push(workspaces[m]);
             continue;
         }
-        match leg.workspace_for_body_height(height, clearance) {
+        match leg.workspace(-height, -height + clearance) {
             Ok(w) => workspaces.push(w),
             Err(e) => {
                 // The largest clearance that still has a workspace, by bisection.
                 let (mut ok, mut bad) = (0.0, clearance);
                 for _ in 0..30 {
                     let m = 0.5 * (ok + bad);
-                    if leg.workspace_for_body_height(height, m).is_ok() {
+                    if leg.workspace(-height, -height + m).is_ok() {
                         ok = m;
                     } else {
                         bad = m;
@@ -371,12 +414,30 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
             }
         }
     }
-    let workspaces: [Workspace; 6] = workspaces.try_into().expect("six legs");
-    let heading = validate_heading(&g.heading, c, dir)?;
+    Ok(Stance { height, workspaces: workspaces.try_into().expect("six legs"), reach, given })
+}
 
-    let Some(p) = periodic else {
-        return free_gait(g, c, heading, height, legs, workspaces, clearance, dt, &reach, given);
-    };
+/// A periodic gait's set-up before its legs are wrapped.
+struct PeriodicWalk {
+    options: GaitOptions,
+    heading: HeadingSpec,
+    navigation: bool,
+    changes: Vec<GaitChange>,
+    joints: [f64; JOINTS],
+}
+
+impl PeriodicWalk {
+    fn on(self, legs: GaitLegs, stance: Stance) -> GaitScenario {
+        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
+    }
+}
+
+/// The periodic gait: every support stroke fits its workspace and the feet start at their
+/// steady footholds.
+#[allow(clippy::too_many_arguments)]
+fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, clearance: f64, dt: f64, duration: f64) -> Result<PeriodicWalk> {
+    let Stance { height, workspaces, reach, given } = stance;
+    let (height, workspaces) = (*height, *workspaces);
     let (cycle, period_s) = (p.cycle, p.period);
     let patterns: Vec<&GaitPattern> = std::iter::once(&p.pattern).chain(p.changes.iter().map(|ch| &ch.pattern)).collect();
 
@@ -418,11 +479,12 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &RobotDescription, dir: &Pat
     }
 
     let options = GaitOptions { period: period_s, pattern: p.pattern, cycle, aep: p.aep, lift: clearance, dt };
-    let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading.source().heading(0.0));
-    let joints = joints_at(&legs, &footholds)
+    let footholds = steady_footholds(legs, &workspaces, height, &options, &heading.source().heading(0.0));
+    let joints = joints_at(legs, &footholds)
         .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.clone()))?;
-    Ok(GaitScenario { options, free: None, heading, navigation: g.navigation, body_height: height, legs, workspaces, changes: p.changes, joints })
+    Ok(PeriodicWalk { options, heading, navigation: g.navigation, changes: p.changes, joints })
 }
+
 
 /// Default takeoff duration of the free gait (s).
 ///
@@ -442,7 +504,8 @@ pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 /// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
 /// its workspace centre, a failed leg held up at the top of its workspace.
 #[allow(clippy::too_many_arguments)]
-fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [LegKinematics; 6], workspaces: [Workspace; 6], lift: f64, dt: f64, reach: &str, given: &str) -> Result<GaitScenario> {
+fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6], stance: Stance, lift: f64, dt: f64) -> Result<GaitScenario> {
+    let Stance { height, workspaces, reach, given } = stance;
     let default = RawFree::default();
     let raw = g.free.as_ref().unwrap_or(&default);
     let positive = |field: &str, v: Option<f64>, default: f64| -> Result<f64> {
@@ -479,14 +542,14 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, height: f64, legs: [Leg
         }
     });
     let joints = joints_at(&legs, &footholds)
-        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.to_string()))?;
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach))?;
     let free_pattern = GaitPattern { name: "free".into(), beta: f64::NAN, offsets: [0.0; 6] };
     let periodic = GaitOptions { period: f64::NAN, pattern: free_pattern, cycle: FootCycle::Plain, aep: AepMode::Omnidirectional, lift, dt };
     let free = FreeGaitSpec { options, landing: match raw.landing {
         LandingKind::Current => LandingSpec::Current { threshold },
         LandingKind::Force => LandingSpec::Force { threshold },
     } };
-    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs, workspaces, changes: Vec::new(), joints })
+    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
 }
 
 /// The period, the patterns, the foot cycle and the gait changes of a periodic gait.

@@ -23,6 +23,13 @@ pub(super) struct RawJointFriction {
     q_h: Option<RawJointParameters>,
 }
 
+impl RawJointFriction {
+    /// Whether no joint's friction is set.
+    pub(super) fn is_empty(&self) -> bool {
+        self.q_r.is_none() && self.q_v.is_none() && self.q_h.is_none()
+    }
+}
+
 /// The parameters of one joint kind; all optional.
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]

@@ -43,10 +43,10 @@ use std::sync::Arc;
 use serde::Deserialize;
 
 use crate::control::{GroundExperiment, JointMotion};
-use crate::description::RobotDescription;
+use crate::description::Robot;
 use crate::fields::{struct_fields, Ctx, DescriptionError, FieldError, SpanIndex};
 use crate::hexapod::JOINTS;
-use crate::robot::model::{FrictionModel, ModelOptions};
+use crate::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use crate::robot::simulation::PlantOptions;
 use crate::physics::Terrain;
 use crate::sim::SimError;
@@ -61,7 +61,7 @@ mod summary;
 mod terrain;
 
 pub use crate::control::gait::schedule::GaitChange;
-pub use gait::{FreeGaitSpec, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
+pub use gait::{FreeGaitSpec, GaitLegs, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
 pub use run::settled_robot;
@@ -210,7 +210,7 @@ pub struct Scenario {
     pub description: String,
     /// Simulated time (s); the run covers round(duration / period) control periods.
     pub duration: f64,
-    pub robot: RobotDescription,
+    pub robot: Robot,
     /// `"amru5"` or the path of the robot description file as opened.
     pub robot_source: String,
     /// The text of the robot description (the embedded file for `"amru5"`).
@@ -279,5 +279,11 @@ impl Scenario {
     /// The control period (s).
     pub fn period(&self) -> f64 {
         self.plant.period
+    }
+
+    /// The robot model of the scenario: its robot's parts under the scenario's model options,
+    /// on its terrain.
+    pub fn model(&self) -> RobotModel {
+        RobotModel::assemble(self.robot.parts(&self.model), self.model.clone(), self.terrain.clone())
     }
 }

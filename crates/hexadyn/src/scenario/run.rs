@@ -13,7 +13,7 @@ use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
 use crate::control::gait::schedule::GaitState;
 use crate::control::{joint_pis, Controller, GroundDetector, GroundExperimentController, GroundExperimentState, JointPiController, JointReferences, Unpowered};
 use crate::robot::columns::{record_row, ColumnGroups};
-use crate::robot::model::{FrictionModel, Robot, RobotModel};
+use crate::robot::model::{FrictionModel, Robot};
 use crate::robot::recorder::{Recorder, TimeSeries};
 use crate::robot::simulation::{run_until, SimulatedRobot};
 use crate::sim::{static_equilibrium, SimError, StaticOptions};
@@ -122,7 +122,7 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
 /// locked (Section 6.2) unless `initial.settle` is off, then the body raised by
 /// `initial.body_height_offset`.
 pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
-    let model = Arc::new(RobotModel::new(&s.robot, s.model.clone(), s.terrain.clone()));
+    let model = Arc::new(s.model());
     let mut q = model.touching_ground(&s.initial.joints);
     // The attitude of the body parallel to the ground, which the settling should keep.
     let (pitch0, roll0) = (q[4], q[5]);
@@ -163,15 +163,16 @@ pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Published) {
             (controller, Published { gait: Some(state), ground: None })
         }
         ControlMode::Pi => {
-            let pis = joint_pis(&s.robot, s.plant.period);
+            let pis = joint_pis(&s.robot.pi_gains(), s.plant.period);
             let motions = s.motions.iter().map(|m| (m.joint_index(), m.motion)).collect();
             (Box::new(JointPiController { pis, references: JointReferences { base: s.initial.joints, motions } }), Published::default())
         }
         ControlMode::Unpowered => (Box::new(Unpowered), Published::default()),
         ControlMode::GroundDetection => {
             let e = s.ground_detection.clone().expect("ground_detection mode has a validated [ground_detection]");
-            let detector = GroundDetector::new(&s.robot, s.plant.period, e.thresholds[0]).expect("a validated description has valid leg kinematics");
-            let (controller, state) = GroundExperimentController::new(e, joint_pis(&s.robot, s.plant.period), s.initial.joints, detector);
+            let d = s.robot.pantograph().expect("ground detection is validated on pantograph legs only");
+            let detector = GroundDetector::new(d, s.plant.period, e.thresholds[0]).expect("a validated description has valid leg kinematics");
+            let (controller, state) = GroundExperimentController::new(e, joint_pis(&d.joint_pi_gains(), s.plant.period), s.initial.joints, detector);
             (Box::new(controller), Published { gait: None, ground: Some(state) })
         }
     }

@@ -58,7 +58,7 @@ pub struct NewmarkOptions {
     /// Newton iterations on the system's surrogate residual allowed after each evaluation of
     /// the residual ([`System::surrogate_residual`]); 0 (the default here): none, the thesis'
     /// iteration on f alone, the right choice for a system whose surrogate is the residual
-    /// itself. The robot's plant takes 8 (`PlantOptions::from_description`): there the
+    /// itself. The robot's plant takes 8 (`PlantOptions::new`): there the
     /// iteration seldom fails at the kinks of the force laws, so the step sequence differs from
     /// the one on f alone within the integration error of Eq. 3.15 (docs/performance-log.md,
     /// sessions 29-30).
@@ -68,7 +68,7 @@ pub struct NewmarkOptions {
     /// last followed a converged surrogate iteration passed the Newton test itself, and no
     /// Newton iteration failed and no step was rejected since. 0 (the default): every step
     /// passes the Newton test on f, the thesis' iteration. The robot's plant takes 8
-    /// (`PlantOptions::from_description`); docs/performance-log.md, session 33, measures what
+    /// (`PlantOptions::new`); docs/performance-log.md, session 33, measures what
     /// the verifications find.
     pub unverified_steps: usize,
 }

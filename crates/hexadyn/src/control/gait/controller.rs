@@ -390,7 +390,7 @@ impl LegState for Leg {
     }
 }
 
-impl std::ops::Deref for GaitController {
+impl<L: LegMechanism> std::ops::Deref for GaitController<L> {
     type Target = Walk<Leg>;
     fn deref(&self) -> &Walk<Leg> {
         &self.walk
@@ -438,7 +438,7 @@ mod tests {
             let options = GaitOptions { period, pattern, cycle, aep: AepMode::Periodic, lift, dt };
             let footholds = steady_footholds(&legs, &workspaces, height, &options, &heading);
             let joints = joints_at(&legs, &footholds).unwrap();
-            let mut controller = GaitController::new(options, legs.clone(), workspaces, joint_pis(&d, dt), Box::new(Constant(heading)));
+            let mut controller = GaitController::new(options, legs.clone(), workspaces, joint_pis(&d.joint_pi_gains(), dt), Box::new(Constant(heading)));
             let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
             let mut outside = 0.0f64;
             for k in 0..(2.0 * period / dt).round() as usize {

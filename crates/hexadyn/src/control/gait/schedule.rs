@@ -14,6 +14,7 @@ use super::controller::{GaitController, GaitDiagnostics};
 use super::free::{FreeGaitController, FreeGaitState};
 use super::pattern::{FootPhase, GaitPattern};
 use crate::control::{Command, Controller, Measurements};
+use crate::hexapod::{Leg, LegKinematics};
 
 /// A gait change while walking: at `at` (s) the controller is asked for `pattern`
 /// ([`GaitController::change_gait`]); it switches once all six feet are down.
@@ -45,22 +46,22 @@ pub struct GaitState {
 pub const FAILED_LEG_CODE: f64 = 4.0;
 
 /// The gait controller with the scheduled gait changes, publishing its state after each update.
-pub struct ScheduledGait {
-    controller: GaitController,
+pub struct ScheduledGait<L: Leg = LegKinematics> {
+    controller: GaitController<L>,
     changes: Vec<GaitChange>,
     next: usize,
     state: Rc<RefCell<GaitState>>,
 }
 
-impl ScheduledGait {
+impl<L: Leg> ScheduledGait<L> {
     /// `changes` at increasing times; returns the controller and the state it publishes.
-    pub fn new(controller: GaitController, changes: Vec<GaitChange>) -> (Self, Rc<RefCell<GaitState>>) {
+    pub fn new(controller: GaitController<L>, changes: Vec<GaitChange>) -> (Self, Rc<RefCell<GaitState>>) {
         let state = Rc::new(RefCell::new(GaitState::default()));
         (ScheduledGait { controller, changes, next: 0, state: state.clone() }, state)
     }
 }
 
-impl Controller for ScheduledGait {
+impl<L: Leg> Controller for ScheduledGait<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let half = 0.5 * self.controller.options.dt;
         while let Some(change) = self.changes.get(self.next).filter(|ch| m.t >= ch.at - half) {

@@ -12,6 +12,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::{JointLimits, LegKinematics, LegKinematicsError, RzMinus};
+use crate::hexapod::workspace::Workspace;
 use crate::spatial::Htm;
 
 /// A leg as the gait controllers use it (Chapter 7), whatever its mechanism: its chain (k(q),
@@ -40,6 +41,12 @@ pub trait Leg: LegChain {
     }
     /// The joints Eq. 7.7 starts from when there are no current ones (a standing posture).
     fn neutral(&self) -> Vector3<f64>;
+    /// The workspace cylinder for foot heights [z_min, z_max] in the leg frame (Section 7.1.1).
+    fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError>;
+    /// The lowest and highest foot heights in the leg frame over the joint ranges.
+    fn height_range(&self) -> (f64, f64);
+    /// Whether `other` reaches the same points of its leg frame (the same workspaces).
+    fn same_leg_frame_reach(&self, other: &Self) -> bool;
     /// [`inverse`] (Eq. 7.7) of a target in the leg frame from `start`.
     fn inverse(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
         inverse(self, target, start)
@@ -69,6 +76,15 @@ impl Leg for LegKinematics {
     /// The neutral posture of Section 4.1 with q_h = 0.03 m.
     fn neutral(&self) -> Vector3<f64> {
         Vector3::new(0.0, 0.06, 0.03)
+    }
+    fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
+        LegKinematics::workspace(self, z_min, z_max)
+    }
+    fn height_range(&self) -> (f64, f64) {
+        LegKinematics::height_range(self)
+    }
+    fn same_leg_frame_reach(&self, other: &Self) -> bool {
+        LegKinematics::same_leg_frame_reach(self, other)
     }
 }
 

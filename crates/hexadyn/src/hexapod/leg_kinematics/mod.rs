@@ -52,7 +52,7 @@ use crate::spatial::{rotation_about, Htm};
 mod inverse;
 mod serial;
 pub use inverse::{inverse, Clamping, IkOptions, IkOutcome, IkSolution, Leg, LegChain, Limit};
-pub use serial::SerialLegKinematics;
+pub use serial::{default_serial_height, SerialLegKinematics};
 
 /// Errors of the leg kinematics: an unusable geometry or non-finite inputs.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

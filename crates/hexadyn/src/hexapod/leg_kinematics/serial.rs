@@ -167,6 +167,26 @@ impl Leg for SerialLegKinematics {
     fn neutral(&self) -> Vector3<f64> {
         self.limits.middle()
     }
+    fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
+        SerialLegKinematics::workspace(self, z_min, z_max)
+    }
+    /// The same chain in the leg frame (a mirrored leg is another chain).
+    fn same_leg_frame_reach(&self, other: &Self) -> bool {
+        (self.origins, self.axes, self.kinds, self.foot, self.limits) == (other.origins, other.axes, other.kinds, other.foot, other.limits)
+    }
+    /// Over a grid of 11 values of each joint's range (the extremes of a chain's foot height
+    /// need not lie on the box's edges).
+    fn height_range(&self) -> (f64, f64) {
+        let (lo, hi) = (self.limits.lower, self.limits.upper);
+        let at = |k: usize, i: usize| lo[k] + (hi[k] - lo[k]) * i as f64 / 10.0;
+        (0..11 * 11 * 11).map(|c| self.foot(&Vector3::new(at(0, c % 11), at(1, c / 11 % 11), at(2, c / 121))).z).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| (a.min(z), b.max(z)))
+    }
+}
+
+/// The default body height of serial legs: the mean height of the feet below the body with
+/// every joint at mid-range (m).
+pub fn default_serial_height(legs: &[SerialLegKinematics; 6]) -> f64 {
+    -legs.iter().map(|l| l.to_body(&l.foot(&l.limits().middle())).z).sum::<f64>() / 6.0
 }
 
 impl LegChain for SerialLegKinematics {

@@ -6,6 +6,7 @@ use std::ops::RangeInclusive;
 use nalgebra::Vector3;
 
 use super::{FrictionModel, ModelOptions};
+use crate::control::{Encoder, PositionServo};
 use crate::description::{JointFrictionParameters, PiGains, RobotDescription};
 use crate::hexapod::{LegJoints, Mechanics, MechanicsParameters, PantographJoint, JOINTS};
 use crate::mbs::{self, BodyId};
@@ -28,6 +29,11 @@ pub struct RobotParts {
     pub strokes: [RangeInclusive<f64>; JOINTS],
     /// PI gains of each joint, for the continuous controllers of [`super::JointControl::ContinuousPid`].
     pub pi_gains: [PiGains; JOINTS],
+    /// The position sensor of each joint (AMRU5: the motor encoders of Section 2.3.2).
+    pub encoders: [Encoder; JOINTS],
+    /// Position servos driving the motors (their own loop, goal positions as inputs), or none:
+    /// the motors take the master's voltages.
+    pub servos: Option<[PositionServo; JOINTS]>,
 }
 
 impl RobotParts {
@@ -55,6 +61,8 @@ impl RobotParts {
                 lo..=hi
             }),
             pi_gains: std::array::from_fn(|k| d.pi_gains(PantographJoint::ALL[k % 3])),
+            encoders: std::array::from_fn(|k| Encoder { counts_per_rev: d.controller.encoder_impulses_per_rev, n: d.reduction(PantographJoint::ALL[k % 3]) }),
+            servos: None,
         }
     }
 }

@@ -130,7 +130,7 @@ impl Robot {
             };
             Foot { position: position + dp, velocity: velocity + j_foot[leg].times(&dqd), proximity }
         });
-        self.force_laws(qd, qdd, &feet);
+        self.force_laws(q, qd, qdd, &feet);
         let mut rows = SVector::<f64, DOF>::from_column_slice(&base.f);
         if let Some(inertial) = &self.inertial {
             rows.gemv(1.0, &inertial.mass, &dqdd, 1.0);

@@ -53,7 +53,7 @@ fn run(c: &mut FreeGaitController, joints: [f64; JOINTS], s: &Setup, dt: f64, du
 }
 
 fn controller(s: &Setup, options: FreeGaitOptions, heading: Heading) -> FreeGaitController {
-    let pis = joint_pis(&s.description, options.dt);
+    let pis = joint_pis(&s.description.joint_pi_gains(), options.dt);
     FreeGaitController::new(options, s.legs.clone(), s.workspaces, pis, Box::new(Constant(heading)), Box::new(NormalForce { threshold: THESIS_FORCE_THRESHOLD }))
 }
 

@@ -1,0 +1,103 @@
+//! The second shipped robot, the PhantomX Mark II (robots/phantomx/phantomx.toml): serial legs
+//! read from its description, Dynamixel AX-12A position servos, and its shipped walks.
+
+use hexadyn::description::serial::mechanism_toml;
+use hexadyn::description::urdf::serial_hexapod_from_file;
+use hexadyn::description::{Robot, SerialRobot, PHANTOMX_TOML};
+use hexadyn::hexapod::SerialHexapod;
+use hexadyn::scenario::{run_scenario, Scenario, Summary, SummaryValue};
+
+fn phantomx() -> SerialRobot {
+    match Robot::from_str(PHANTOMX_TOML, "phantomx.toml").unwrap() {
+        Robot::Serial(s) => s,
+        Robot::Pantograph(_) => panic!("a serial robot"),
+    }
+}
+
+fn root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The largest difference between two mechanisms' numbers.
+fn difference(a: &SerialHexapod, b: &SerialHexapod) -> f64 {
+    let mut d = (a.base.mass - b.base.mass).abs().max((a.base.com - b.base.com).amax()).max((a.base.inertia - b.base.inertia).amax());
+    for (la, lb) in a.legs.iter().zip(&b.legs) {
+        d = d.max((la.foot - lb.foot).amax()).max((la.foot_radius - lb.foot_radius).abs());
+        for (ja, jb) in la.joints.iter().zip(&lb.joints) {
+            assert_eq!((&ja.name, ja.kind), (&jb.name, jb.kind));
+            d = d.max((ja.origin.rotation - jb.origin.rotation).amax()).max((ja.origin.translation - jb.origin.translation).amax());
+            d = d.max((ja.axis - jb.axis).amax()).max((ja.lower - jb.lower).abs()).max((ja.upper - jb.upper).abs());
+        }
+        for (ka, kb) in la.links.iter().zip(&lb.links) {
+            d = d.max((ka.mass - kb.mass).abs()).max((ka.com - kb.com).amax()).max((ka.inertia - kb.inertia).amax());
+        }
+    }
+    d
+}
+
+/// The shipped description's mechanism is its URDF's (SOURCES.md), and a description written
+/// back to TOML reads as the same robot.
+#[test]
+fn the_description_is_its_urdf_and_round_trips() {
+    let robot = phantomx();
+    let urdf = serial_hexapod_from_file(root().join("robots/phantomx/phantomx.urdf")).unwrap();
+    let d = difference(&robot.hexapod, &urdf);
+    assert!(d < 1e-12, "the description differs from the URDF by {d}");
+    let again = match Robot::from_str(&robot.to_toml(), "written").unwrap() {
+        Robot::Serial(s) => s,
+        _ => unreachable!(),
+    };
+    assert!(difference(&again.hexapod, &robot.hexapod) < 1e-12);
+    assert_eq!((again.drives, again.joints, again.period, again.supply_voltage, again.ground), (robot.drives.clone(), robot.joints.clone(), robot.period, robot.supply_voltage, robot.ground.clone()));
+    let names = ["coxa", "femur", "tibia"].map(String::from);
+    assert!(robot.to_toml().starts_with(&mechanism_toml(&robot.hexapod, &names)));
+    assert!((robot.total_mass_kg() - 1.8428).abs() < 1e-9, "{}", robot.total_mass_kg());
+}
+
+/// A broken serial description is refused in one line naming the field and what is allowed.
+#[test]
+fn a_broken_serial_description_names_its_field() {
+    let cases = [
+        ("sigma_0 = 5900.0", "sigma_0 = -1.0", "drives.coxa.friction.sigma_0"),
+        ("[drives.tibia.servo]", "[drives.tibia.pi]\nk = 1.0\nt_i_s = 1.0\nbridge_resistance_ohm = 0.0\nencoder_counts_per_rev = 500.0\n[drives.tibia.unused]", "drives.tibia"),
+        ("names = [\"coxa\", \"femur\", \"tibia\"]", "names = [\"coxa\", \"femur\", \"knee\"]", "drives.knee"),
+        ("foot_radius_m = 0.01\n", "foot_radius_m = 0.02\n", "legs[1].foot_radius_m"),
+        ("mass_kg = 0.0696", "mass_kg = -0.0696", "legs[0].joints[0].link.mass_kg"),
+        ("upper = 1.413717", "upper = -2.0", "legs[0].joints[0].upper"),
+        ("punch = 0.031280547", "punch = 2.0", "drives.coxa.servo.punch"),
+    ];
+    for (from, to, field) in cases {
+        assert!(PHANTOMX_TOML.contains(from), "{from}");
+        let text = PHANTOMX_TOML.replacen(from, to, 1);
+        let e = Robot::from_str(&text, "broken.toml").expect_err(to);
+        let message = e.to_string();
+        assert!(!message.contains('\n'), "{message}");
+        assert!(message.contains(field) && message.starts_with("broken.toml"), "{to}: {message}");
+    }
+}
+
+fn number(s: &Summary, key: &str) -> f64 {
+    match s.entries().into_iter().find(|(k, _)| k == key).unwrap_or_else(|| panic!("no {key}")).1 {
+        SummaryValue::Number(v) => v,
+        SummaryValue::Count(n) => n as f64,
+        other => panic!("{key}: {other:?}"),
+    }
+}
+
+/// The shipped walks of the issue: 0 clamped IK references, the energy account closed within
+/// 0.1 % of the electrical energy, and the body where the gait took it.
+#[test]
+fn the_shipped_walks_walk() {
+    for (name, advance) in [("phantomx_tripod", 0.7), ("phantomx_wave", 0.7), ("phantomx_spline", 0.95)] {
+        let s = Scenario::from_file(root().join(format!("python/hexadyn/scenarios/{name}.toml"))).unwrap();
+        let r = run_scenario(&s, |_| {}).unwrap();
+        let summary = &r.summary;
+        let (walked, reference) = (number(summary, "distance_walked_m"), number(summary, "reference_distance_m"));
+        let balance = number(summary, "energy_balance_error_relative");
+        let clamped = number(summary, "clamped_ik_references");
+        println!("{name}: walked {walked:.4} m of {reference:.4} m, balance {balance:.2e}, clamped {clamped}, path error {:.4} m", number(summary, "tracking_error_xy_max_m"));
+        assert_eq!(clamped, 0.0, "{name}");
+        assert!(balance.abs() < 1e-3, "{name}: energy balance {balance}");
+        assert!(walked > advance * reference, "{name}: {walked} m of {reference} m");
+    }
+}
