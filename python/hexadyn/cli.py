@@ -356,6 +356,21 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, 
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
 
 
+@cli.command("import-urdf")
+@click.argument("urdf_file", type=click.Path(path_type=Path))
+@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="The robot description to write (TOML, docs/robot-format.md).")
+@click.option("--joint-names", default="coxa,femur,tibia", show_default=True, help="The names of a leg's three joints from the body to the foot, comma-separated: the results' columns.")
+@click.option("--drives", "drives_file", type=click.Path(path_type=Path), default=None, help="A serial robot description whose drives, controller and ground to use [default: the shipped PhantomX's AX-12A servos].")
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+def import_urdf_command(urdf_file: Path, out_file: Path, joint_names: str, drives_file: Path | None, overwrite: bool) -> None:
+    """Write a hexadyn robot description of a URDF hexapod (six chains of three joints)."""
+    from hexadyn.urdf import import_urdf
+
+    names = tuple(n.strip() for n in joint_names.split(","))
+    path = import_urdf(urdf_file, out_file, names, drives_file, overwrite)
+    click.echo(f"Robot description: {path} (scenario.robot = \"{path}\"; check its drives)")
+
+
 @cli.command("urdf")
 @click.argument("urdf_file", type=click.Path(path_type=Path))
 @click.option("--height", type=float, default=None, help="Body height (m) for the workspaces [default: feet on the ground with the joints mid-range].")

@@ -16,7 +16,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["inspect", "standing_height", "write_mjcf"]
+__all__ = ["import_urdf", "inspect", "standing_height", "write_mjcf"]
 
 
 def standing_height(robot) -> float:
@@ -73,5 +73,48 @@ def write_mjcf(urdf: str | os.PathLike, out: str | os.PathLike) -> Path:
 
     text = UrdfHexapod.from_file(os.fspath(urdf)).to_mjcf()
     target = Path(out)
+    atomic.write_file(target, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return target
+
+
+def import_urdf(
+    urdf: str | os.PathLike,
+    out: str | os.PathLike,
+    joint_names: tuple[str, str, str] = ("coxa", "femur", "tibia"),
+    drives: str | os.PathLike | None = None,
+    overwrite: bool = False,
+) -> Path:
+    """Writes a hexadyn robot description (``docs/robot-format.md``) of the hexapod of a URDF
+    file to `out`, atomically, and returns `out`: the mechanism as hexadyn reads it (the six
+    legs numbered the thesis way, fixed links merged, the foot spheres), the per-leg joint
+    names `joint_names` (the results' columns), and the drives, controller and ground of the
+    serial robot description `drives` (default: the shipped PhantomX's Dynamixel AX-12A,
+    ``robots/phantomx/phantomx.toml``), joint by joint in order: replace them with your robot's.
+    The written file is read back by the engine before it is kept. ValueError (one line) for a
+    file hexadyn cannot model, an existing `out` without `overwrite`, or bad names."""
+    from hexadyn import atomic
+    from hexadyn._core import UrdfHexapod, shipped_robot_text
+
+    names = list(joint_names)
+    if len(names) != 3:
+        raise ValueError(f"joint names = {joint_names!r}: allowed three names, one per joint of a leg from the body to the foot")
+    target = Path(out)
+    if target.exists() and not overwrite:
+        raise ValueError(f"{target}: exists; allowed: a new file, or --overwrite")
+    if drives is None:
+        template, origin = shipped_robot_text("phantomx"), "the shipped PhantomX description (robots/phantomx/phantomx.toml)"
+    else:
+        origin = os.fspath(drives)
+        try:
+            template = Path(drives).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{origin}: cannot read the drives' description: {exc}") from None
+    robot = UrdfHexapod.from_file(os.fspath(urdf))
+    header = (
+        f"# {robot.name}: imported from {Path(urdf).name} by `hexadyn import-urdf`.\n"
+        f"# The drives, controller and ground are those of {origin}:\n"
+        "# replace them with your robot's (docs/robot-format.md).\n\n"
+    )
+    text = header + robot.description_toml(names, template, origin)
     atomic.write_file(target, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return target

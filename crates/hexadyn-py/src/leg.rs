@@ -25,8 +25,7 @@ impl PyLegModel {
     #[new]
     #[pyo3(signature = (robot_text = None, origin = "robot description"))]
     fn new(robot_text: Option<&str>, origin: &str) -> PyResult<Self> {
-        let description = RobotDescription::from_str(robot_text.unwrap_or(AMRU5_TOML), origin)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let description = crate::schema::pantograph_description(robot_text.unwrap_or(AMRU5_TOML), origin, "friction identification")?;
         let mechanics = Mechanics::new(&MechanicsParameters::from_description(&description))
             .map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
         let data = Data::new(&mechanics.model);

@@ -70,3 +70,13 @@ pub fn robot_properties<'py>(py: Python<'py>, text: &str, origin: &str) -> PyRes
 pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 {
     hexadyn::scenario::specific_resistance(energy_j, mass_kg, distance_m)
 }
+
+/// The pantograph description of a robot description text, for the tools written for AMRU5's
+/// legs (`what`, e.g. "the 3D viewer"): ValueError (one line) for an invalid description or a
+/// serial one.
+pub fn pantograph_description(text: &str, origin: &str, what: &str) -> PyResult<hexadyn::description::RobotDescription> {
+    match Robot::from_str(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))? {
+        Robot::Pantograph(d) => Ok(d),
+        Robot::Serial(s) => Err(PyValueError::new_err(format!("{origin}: robot {:?} has serial legs; allowed: a pantograph robot (AMRU5's legs): {what} is not available on serial legs yet", s.name))),
+    }
+}

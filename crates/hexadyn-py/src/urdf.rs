@@ -3,6 +3,7 @@
 //! gravity forces, kinetic energy) with the legs' joint names, feet and foot Jacobians.
 
 use hexadyn::description::mjcf::serial_hexapod_to_mjcf;
+use hexadyn::description::Robot;
 use hexadyn::description::urdf::{serial_hexapod_from_file, serial_hexapod_from_urdf, UrdfError};
 use hexadyn::hexapod::{Leg, LegChain, SerialHexapod, SerialLegKinematics, DOF, LEG_COUNT};
 use nalgebra::Vector3;
@@ -89,11 +90,19 @@ impl PyUrdfHexapod {
         serial_hexapod_to_mjcf(&self.robot, hexadyn::mbs::STANDARD_GRAVITY)
     }
 
-    /// The mechanism tables of a serial robot description (`description::serial::mechanism_toml`)
-    /// with the per-leg joint names `joint_names`: what `hexadyn import-urdf` writes before the
-    /// drives.
-    fn mechanism_toml(&self, joint_names: [String; 3]) -> String {
-        hexadyn::description::serial::mechanism_toml(&self.robot, &joint_names)
+    /// A serial robot description of this robot (`docs/robot-format.md`) with the per-leg
+    /// joint names `joint_names` and the drives, controller and ground of the serial robot
+    /// description `template` (`origin` names it in errors), read back by the engine before it
+    /// is returned: what `hexadyn import-urdf` writes. ValueError (one line) for a template that
+    /// is not a valid serial description or bad names.
+    fn description_toml(&self, joint_names: [String; 3], template: &str, origin: &str) -> PyResult<String> {
+        let Robot::Serial(drives) = Robot::from_str(template, origin).map_err(value_error)? else {
+            return Err(PyValueError::new_err(format!("{origin}: a pantograph description; allowed: a serial robot description (leg_mechanism = \"serial\") whose drives to use")));
+        };
+        let robot = drives.with_mechanism(self.robot.clone(), joint_names.clone()).map_err(|e| PyValueError::new_err(format!("joint names {joint_names:?}: {e}; allowed: three distinct identifiers that are not per-leg column names")))?;
+        let text = robot.to_toml();
+        Robot::from_str(&text, "the imported description").map_err(value_error)?;
+        Ok(text)
     }
 
     /// The base link's mass with the links fixed to it (kg).
@@ -173,4 +182,14 @@ impl PyUrdfHexapod {
         }
         Ok(PyArray3::from_vec3(self_.py(), &j)?)
     }
+}
+
+/// The text of a shipped robot description (`"amru5"`, `"phantomx"`: the names a scenario's
+/// `robot` takes). ValueError for another name.
+#[pyfunction]
+pub fn shipped_robot_text(name: &str) -> PyResult<&'static str> {
+    hexadyn::description::SHIPPED_ROBOTS.iter().find(|(n, _, _)| *n == name).map(|(_, text, _)| *text).ok_or_else(|| {
+        let names: Vec<String> = hexadyn::description::SHIPPED_ROBOTS.iter().map(|(n, _, _)| format!("{n:?}")).collect();
+        PyValueError::new_err(format!("robot {name:?}: not shipped; allowed: {}", names.join(", ")))
+    })
 }

@@ -3,7 +3,6 @@
 //! kinematics (Eq. 3.51-3.71), vectorized over frames. The viewer (`hexadyn.view`) draws the
 //! robot from these, so the legs move exactly as in the simulation.
 
-use hexadyn::description::RobotDescription;
 use hexadyn::hexapod::{Mechanics, MechanicsParameters, DOF};
 use hexadyn::mbs::{kinematics, BodyId, Data};
 use nalgebra::Vector3;
@@ -52,7 +51,7 @@ impl PyKinematics {
     #[new]
     #[pyo3(signature = (robot_text, origin = "robot description"))]
     fn new(robot_text: &str, origin: &str) -> PyResult<Self> {
-        let description = RobotDescription::from_str(robot_text, origin).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let description = crate::schema::pantograph_description(robot_text, origin, "the 3D viewer")?;
         let parameters = MechanicsParameters::from_description(&description);
         let mechanics = Mechanics::new(&parameters).map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
         let p = &mechanics.parameters;

@@ -533,3 +533,48 @@ impl SerialRobot {
         Ok(SerialRobot { name: hexapod.name.clone(), hexapod, joints, ..self.clone() })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fields::struct_fields;
+
+    /// docs/robot-format.md documents every key of the loader's tables, and no other: each
+    /// table's keys are the first column of the page's section for it.
+    #[test]
+    fn the_format_page_documents_every_key() {
+        let page = include_str!("../../../../docs/robot-format.md");
+        let tables: [(&str, &[&str]); 11] = [
+            ("## Top level", struct_fields::<SerialDescriptionFile>()),
+            ("## `[joints]`", struct_fields::<SerialJointsTable>()),
+            ("## `[base]`", struct_fields::<LinkTable>()),
+            ("## `[[legs]]`", struct_fields::<LegTable>()),
+            ("### `[[legs.joints]]`", struct_fields::<JointTable>()),
+            ("## `[drives.<joint name>]`", struct_fields::<DriveTable>()),
+            ("### `[drives.<joint>.motor]`", struct_fields::<MotorSpec>()),
+            ("### `[drives.<joint>.friction]`", struct_fields::<FrictionSpec>()),
+            ("### `[drives.<joint>.servo]`", struct_fields::<ServoSpec>()),
+            ("### `[drives.<joint>.pi]`", struct_fields::<PiSpec>()),
+            ("## `[controller]`", struct_fields::<SerialControllerTable>()),
+        ];
+        let ground = ("## `[ground]`", struct_fields::<GroundTable>());
+        let section_keys = |heading: &str| -> Vec<String> {
+            let start = page.find(heading).unwrap_or_else(|| panic!("no section {heading}"));
+            let rest = &page[start + heading.len()..];
+            let end = rest.find("\n#").unwrap_or(rest.len());
+            rest[..end]
+                .lines()
+                .filter_map(|l| l.strip_prefix("| `"))
+                .flat_map(|l| l.split(" |").next().unwrap_or("").split(", ").map(|k| k.trim_matches('`').to_string()).collect::<Vec<_>>())
+                .collect()
+        };
+        for (heading, fields) in tables.iter().chain([&ground]) {
+            let mut documented = section_keys(heading);
+            documented.sort();
+            // The tables of tables are documented in their own sections.
+            let mut expected: Vec<String> = fields.iter().filter(|f| !["joints", "base", "legs", "drives", "controller", "ground", "motor", "friction", "servo", "pi"].contains(f) || (*heading == "## `[[legs]]`" && **f == "joints")).map(|f| f.to_string()).collect();
+            expected.sort();
+            assert_eq!(documented, expected, "{heading}");
+        }
+    }
+}

@@ -330,14 +330,15 @@ struct InertialJacobian {
 
 impl InertialJacobian {
     /// Whether the configuration moved little enough since it was taken: 0.2 rad on the body
-    /// attitude and on q_r, 2 cm on the nuts (about a third of their strokes). The body
+    /// attitude and on the revolute joints (AMRU5's q_r), 2 cm on the prismatic ones (AMRU5's
+    /// nuts, about a third of their strokes). The body
     /// position does not matter: inertia and gravity do not change with a translation. These
     /// terms are small beside the contact and motor terms, which are exact at every call:
     /// benches/walk counts the same Newton iterations with this part re-taken every 10 mrad and
     /// 1 mm, at twice the cost.
-    fn holds_at(&self, q: &[f64]) -> bool {
+    fn holds_at(&self, q: &[f64], joints: &LegJoints) -> bool {
         (3..DOF).all(|i| {
-            let tolerance = if i < 6 || (i - 6) % 3 == 0 { 0.2 } else { 0.02 };
+            let tolerance = if i < 6 || joints.kind((i - 6) % 3) == JointKind::Revolute { 0.2 } else { 0.02 };
             (q[i] - self.q[i]).abs() <= tolerance
         })
     }
@@ -604,7 +605,7 @@ impl System for Robot {
         // The inertial part is re-taken only when the configuration has moved (modified Newton
         // already tolerates an approximate Jacobian; the contact and joint terms, which carry
         // the fast and non-smooth changes, are exact at every call).
-        if !self.inertial.as_ref().is_some_and(|c| c.holds_at(q)) {
+        if !self.inertial.as_ref().is_some_and(|c| c.holds_at(q, &self.model.joints)) {
             self.inertial = Some(self.inertial_jacobian(q, qd, qdd));
         }
         self.evaluate(q, qd, qdd);
