@@ -8,8 +8,27 @@ use std::sync::Mutex;
 use super::leg_kinematics::{JointLimits, LegKinematics, LegKinematicsError};
 use super::pantograph::PantographGeometry;
 
-/// Workspaces remembered by [`LegKinematics::workspace`].
+/// Workspaces remembered by [`LegKinematics::workspace`] and
+/// [`super::SerialLegKinematics::workspace`].
 pub const RECENT_WORKSPACES: usize = 64;
+
+/// The last [`RECENT_WORKSPACES`] workspace searches of a leg mechanism, by their key.
+pub(crate) type Recent<K> = Mutex<Vec<(K, Result<Workspace, LegKinematicsError>)>>;
+
+/// The workspace of `key` from `recent`, or `search`ed and remembered (the oldest forgotten).
+pub(crate) fn remembered<K: PartialEq + Clone>(recent: &Recent<K>, key: K, search: impl FnOnce() -> Result<Workspace, LegKinematicsError>) -> Result<Workspace, LegKinematicsError> {
+    if let Some((_, found)) = recent.lock().ok().and_then(|r| r.iter().find(|(k, _)| *k == key).cloned()) {
+        return found;
+    }
+    let result = search();
+    if let Ok(mut r) = recent.lock() {
+        if r.len() >= RECENT_WORKSPACES {
+            let _forgotten = r.remove(0);
+        }
+        r.push((key, result.clone()));
+    }
+    result
+}
 
 impl LegKinematics {
 
@@ -87,20 +106,8 @@ impl LegKinematics {
     /// The last [`RECENT_WORKSPACES`] results are kept (a campaign or a sweep validates the same
     /// walk many times; the search costs milliseconds).
     pub fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
-        type Recent = Vec<((PantographGeometry, Vector3<f64>, JointLimits, u64, u64), Result<Workspace, LegKinematicsError>)>;
-        static RECENT: Mutex<Recent> = Mutex::new(Vec::new());
-        let key = (self.pantograph, self.crossing, self.limits, z_min.to_bits(), z_max.to_bits());
-        if let Some((_, found)) = RECENT.lock().ok().and_then(|r| r.iter().find(|(k, _)| *k == key).cloned()) {
-            return found;
-        }
-        let result = self.search_workspace(z_min, z_max);
-        if let Ok(mut recent) = RECENT.lock() {
-            if recent.len() >= RECENT_WORKSPACES {
-                let _forgotten = recent.remove(0);
-            }
-            recent.push((key, result.clone()));
-        }
-        result
+        static RECENT: Recent<(PantographGeometry, Vector3<f64>, JointLimits, u64, u64)> = Mutex::new(Vec::new());
+        remembered(&RECENT, (self.pantograph, self.crossing, self.limits, z_min.to_bits(), z_max.to_bits()), || self.search_workspace(z_min, z_max))
     }
 
     fn search_workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {

@@ -384,11 +384,6 @@ fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_tex
     if !(height.is_finite() && height > 0.0) {
         return Err(c.err("gait.body_height_m", height, "not a positive finite number", reach));
     }
-    for leg in legs {
-        if leg.workspace(-height, -height).is_err() {
-            return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach));
-        }
-    }
     let mut workspaces: Vec<Workspace> = Vec::with_capacity(6);
     for (l, leg) in legs.iter().enumerate() {
         // The workspace search is costly (a large share of a short walk's run time): legs that
@@ -399,6 +394,8 @@ fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_tex
         }
         match leg.workspace(-height, -height + clearance) {
             Ok(w) => workspaces.push(w),
+            // No workspace even without a clearance: the height is the problem.
+            Err(_) if leg.workspace(-height, -height).is_err() => return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach)),
             Err(e) => {
                 // The largest clearance that still has a workspace, by bisection.
                 let (mut ok, mut bad) = (0.0, clearance);

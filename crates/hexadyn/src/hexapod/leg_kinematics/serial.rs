@@ -21,7 +21,9 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::inverse::{inverse, IkOptions, Leg, LegChain};
 use super::{JointLimits, LegKinematicsError};
-use crate::hexapod::workspace::{argmax, Workspace};
+use std::sync::Mutex;
+
+use crate::hexapod::workspace::{argmax, remembered, Recent, Workspace};
 use crate::hexapod::{JointKind, SerialLeg};
 use crate::spatial::{rotation_about, Htm};
 
@@ -136,7 +138,16 @@ impl SerialLegKinematics {
     }
 
     /// The workspace cylinder for foot heights [z_min, z_max] (leg frame), see the module docs.
+    /// The last searches are kept, as the pantograph's (a scenario validates its stance and its
+    /// walk on the same legs; a campaign the same walk many times).
     pub fn workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
+        // The leg frame's reach: the chain without its mounting (see `same_leg_frame_reach`).
+        type Key = ([Htm; 3], [Vector3<f64>; 3], [JointKind; 3], Vector3<f64>, JointLimits, u64, u64);
+        static RECENT: Recent<Key> = Mutex::new(Vec::new());
+        remembered(&RECENT, (self.origins, self.axes, self.kinds, self.foot, self.limits, z_min.to_bits(), z_max.to_bits()), || self.search_workspace(z_min, z_max))
+    }
+
+    fn search_workspace(&self, z_min: f64, z_max: f64) -> Result<Workspace, LegKinematicsError> {
         if !(z_min.is_finite() && z_max.is_finite()) {
             return Err(LegKinematicsError::NonFinite("workspace height range"));
         }
