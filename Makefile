@@ -25,7 +25,7 @@ help:
 	@echo "make lint   clippy on every crate and target, warnings as errors"
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
-	@echo "make bench-peer  the 75 s walk in hexadyn and in MuJoCo, timed in the same run"
+	@echo "make bench-peer  the 75 s AMRU5 walk and the PhantomX tripod in hexadyn and in MuJoCo, timed in the same run"
 	@echo "make bench-urdf  a URDF hexapod's mass matrix and nonlinear effects in hexadyn and in Pinocchio"
 	@echo "make bench-montecarlo [MC_ARGS=\"--runs 50\"]  time a Monte Carlo campaign on every core (long)"
 	@echo "make terrains  regenerate the shipped terrain PLY files (python/hexadyn/scenarios/terrains)"
@@ -90,6 +90,7 @@ terrains:
 bench-peer: setup
 	$(PY) -m pip install --quiet --disable-pip-version-check -c $(LOCK) mujoco
 	$(PY) benches/peer_mujoco.py
+	$(PY) benches/peer_mujoco_phantomx.py
 
 # Rigid-body evaluation of a serial hexapod from URDF, against Pinocchio (a test dependency).
 bench-urdf: setup

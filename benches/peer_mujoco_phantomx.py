@@ -36,6 +36,7 @@ except ImportError:  # a benchmark-only dependency
     sys.exit("benches/peer_mujoco_phantomx.py needs MuJoCo: pip install -c requirements/lock.txt -e '.[bench]'")
 
 from hexadyn import _core
+from peer_mujoco import hexadyn_walk, ypr_quaternion  # the AMRU5 peer benchmark's, same folder
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO = ROOT / "python/hexadyn/scenarios/phantomx_tripod.toml"
@@ -43,14 +44,6 @@ ROBOT = ROOT / "robots/phantomx/phantomx.toml"
 URDF = ROOT / "robots/phantomx/phantomx.urdf"
 DT = 1e-3
 JOINTS = ("coxa", "femur", "tibia")
-
-
-def hexadyn_walk() -> tuple[dict, float, float]:
-    """Runs the shipped scenario with its time series; returns (columns, wall s, CPU s)."""
-    wall, cpu = time.perf_counter(), time.process_time()
-    r = _core.run_scenario(SCENARIO, None, None, True)
-    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    return {k: np.asarray(v) for k, v in r["columns"].items()}, wall, cpu
 
 
 def phantomx_mjcf() -> str:
@@ -85,12 +78,6 @@ def phantomx_mjcf() -> str:
     return xml.replace("<option ", f'<option timestep="{DT}" integrator="implicitfast" ', 1)
 
 
-def ypr_quaternion(yaw: float, pitch: float, roll: float) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of R_z(yaw) R_y(pitch) R_x(roll)."""
-    cy, sy, cp, sp, cr, sr = (f(a / 2) for a in (yaw, pitch, roll) for f in (math.cos, math.sin))
-    return np.array([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
-
-
 def mujoco_walk(model, c: dict, ctrl: np.ndarray, settle_s: float = 1.0):
     """From hexadyn's initial pose and joints, settles under the first targets (not timed),
     then replays the targets with a zero-order hold over each control period. Returns
@@ -121,7 +108,7 @@ def main() -> None:
     args = parser.parse_args()
     if args.repeats < 1:
         parser.error(f"--repeats {args.repeats}: must be at least 1")
-    c, hx_wall, hx_cpu = hexadyn_walk()
+    c, hx_wall, hx_cpu = hexadyn_walk(SCENARIO)
     xml = phantomx_mjcf()
     if args.xml:
         args.xml.write_text(xml)
@@ -130,7 +117,7 @@ def main() -> None:
     x, mj_wall, mj_cpu = mujoco_walk(model, c, ctrl)
     pairs = [(hx_wall, hx_cpu, mj_wall, mj_cpu)]
     for _ in range(args.repeats - 1):
-        _, hw, hc = hexadyn_walk()
+        _, hw, hc = hexadyn_walk(SCENARIO)
         _, mw, mc = mujoco_walk(model, c, ctrl)
         pairs.append((hw, hc, mw, mc))
     hx_wall, hx_cpu, mj_wall, mj_cpu = (float(np.median(column)) for column in zip(*pairs))
