@@ -371,6 +371,17 @@ def import_urdf_command(urdf_file: Path, out_file: Path, joint_names: str, drive
     click.echo(f"Robot description: {path} (scenario.robot = \"{path}\"; check its drives)")
 
 
+@cli.command("export-urdf")
+@click.argument("robot")
+@click.argument("out_file", type=click.Path(path_type=Path))
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+def export_urdf_command(robot: str, out_file: Path, overwrite: bool) -> None:
+    """Write a serial robot (shipped name or description file) as URDF, for ROS and MuJoCo users."""
+    from hexadyn.urdf import export_urdf
+
+    click.echo(f"URDF: {export_urdf(robot, out_file, overwrite)}")
+
+
 @cli.command("urdf")
 @click.argument("urdf_file", type=click.Path(path_type=Path))
 @click.option("--height", type=float, default=None, help="Body height (m) for the workspaces [default: feet on the ground with the joints mid-range].")

@@ -16,7 +16,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["import_urdf", "inspect", "standing_height", "write_mjcf"]
+__all__ = ["export_urdf", "import_urdf", "inspect", "standing_height", "write_mjcf"]
 
 
 def standing_height(robot) -> float:
@@ -117,4 +117,31 @@ def import_urdf(
     )
     text = header + robot.description_toml(names, template, origin)
     atomic.write_file(target, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return target
+
+
+def export_urdf(robot: str | os.PathLike, out: str | os.PathLike, overwrite: bool = False) -> Path:
+    """Writes a serial robot (a shipped name such as ``"phantomx"`` or a description file) as
+    URDF to `out`, atomically, and returns `out`: ``base_link``, a link per joint with its
+    inertial, the joints with their ranges and the drives' stall torque and no-load speed as
+    limits, the foot spheres as collisions (``SerialRobot::to_urdf``; the importer reads it back
+    as the same mechanism). ValueError (one line) for a pantograph robot, an unreadable file or
+    an existing `out` without `overwrite`."""
+    from hexadyn import atomic
+    from hexadyn._core import robot_urdf, shipped_robot_text
+
+    target = Path(out)
+    if target.exists() and not overwrite:
+        raise ValueError(f"{target}: exists; allowed: a new file, or --overwrite")
+    name = os.fspath(robot)
+    try:
+        text, origin = shipped_robot_text(name), name
+    except ValueError:
+        origin = name
+        try:
+            text = Path(robot).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{origin}: cannot read the robot description: {exc}") from None
+    urdf = robot_urdf(text, origin)
+    atomic.write_file(target, lambda tmp: tmp.write_text(urdf, encoding="utf-8"))
     return target

@@ -18,6 +18,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mbs::PyMultibody>()?;
     m.add_class::<urdf::PyUrdfHexapod>()?;
     m.add_function(wrap_pyfunction!(urdf::shipped_robot_text, m)?)?;
+    m.add_function(wrap_pyfunction!(urdf::robot_urdf, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::load_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::scenario_model, m)?)?;

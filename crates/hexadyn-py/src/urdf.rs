@@ -193,3 +193,15 @@ pub fn shipped_robot_text(name: &str) -> PyResult<&'static str> {
         PyValueError::new_err(format!("robot {name:?}: not shipped; allowed: {}", names.join(", ")))
     })
 }
+
+/// The URDF of a serial robot description (`SerialRobot::to_urdf`, what `hexadyn export-urdf`
+/// writes); `origin` names the description in errors. ValueError (one line) for an invalid or a
+/// pantograph description (its closed chains have no URDF form).
+#[pyfunction]
+#[pyo3(signature = (text, origin = "robot description"))]
+pub fn robot_urdf(text: &str, origin: &str) -> PyResult<String> {
+    match Robot::from_str(text, origin).map_err(value_error)? {
+        Robot::Serial(s) => Ok(s.to_urdf()),
+        Robot::Pantograph(d) => Err(PyValueError::new_err(format!("{origin}: robot {:?} has pantograph legs; allowed: a serial robot description (a pantograph's closed chains have no URDF form)", d.name))),
+    }
+}

@@ -54,6 +54,18 @@ fn the_description_is_its_urdf_and_round_trips() {
     assert!((robot.total_mass_kg() - 1.8428).abs() < 1e-9, "{}", robot.total_mass_kg());
 }
 
+/// The robot written as URDF reads back as the same mechanism (`hexadyn export-urdf`).
+#[test]
+fn the_urdf_export_reads_back_as_the_same_robot() {
+    let robot = phantomx();
+    let text = robot.to_urdf();
+    let again = hexadyn::description::urdf::serial_hexapod_from_urdf(&text, "exported.urdf").unwrap();
+    let d = difference(&again, &robot.hexapod);
+    assert!(d < 1e-12, "the exported URDF differs by {d}");
+    // The AX-12A's limits: stall torque 1.39 N m/A x 11.1 V / 8 ohm, no-load speed 11.1 V / 1.39.
+    assert!(text.contains("effort=\"1.93") && text.contains("velocity=\"7.96"), "{}", &text[..600]);
+}
+
 /// A broken serial description is refused in one line naming the field and what is allowed.
 #[test]
 fn a_broken_serial_description_names_its_field() {

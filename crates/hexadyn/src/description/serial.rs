@@ -534,6 +534,67 @@ impl SerialRobot {
     }
 }
 
+impl SerialRobot {
+    /// The robot as URDF (the inverse of `hexadyn import-urdf`): `base_link` and per joint a
+    /// link `<joint name>_link` with its inertial (centre of mass and tensor in the link axes),
+    /// the joints with their origins, axes and ranges, the effort limit the drive's stall
+    /// torque n k_t L V / R and the velocity limit its no-load speed V / (n k_t) at the supply,
+    /// and the foot sphere as the last link's collision. Read back by the importer, it is the
+    /// same mechanism.
+    pub fn to_urdf(&self) -> String {
+        let v = |a: &[f64]| a.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(" ");
+        let escape = |s: &str| quick_xml::escape::escape(s).into_owned();
+        let inertial = |l: &Link| {
+            let i = &l.inertia;
+            format!(
+                "    <inertial>\n      <origin xyz=\"{}\" rpy=\"0 0 0\"/>\n      <mass value=\"{:?}\"/>\n      <inertia ixx=\"{:?}\" ixy=\"{:?}\" ixz=\"{:?}\" iyy=\"{:?}\" iyz=\"{:?}\" izz=\"{:?}\"/>\n    </inertial>\n",
+                v(l.com.as_slice()),
+                l.mass,
+                i[(0, 0)],
+                i[(0, 1)],
+                i[(0, 2)],
+                i[(1, 1)],
+                i[(1, 2)],
+                i[(2, 2)]
+            )
+        };
+        let mut out = format!("<?xml version=\"1.0\"?>\n<!-- {} written by hexadyn from its robot description -->\n<robot name=\"{}\">\n  <link name=\"base_link\">\n{}  </link>\n", escape(&self.name), escape(&self.name), inertial(&self.hexapod.base));
+        for leg in &self.hexapod.legs {
+            let mut parent = "base_link".to_string();
+            for (k, (joint, link)) in leg.joints.iter().zip(&leg.links).enumerate() {
+                let d = &self.drives[k];
+                let gain = d.gear_ratio * d.motor.torque_constant_nm_per_a;
+                let limit = match &d.control {
+                    DriveControl::Servo(s) => s.torque_limit,
+                    DriveControl::Pi(_) => 1.0,
+                };
+                let (effort, velocity) = (gain * limit * self.supply_voltage / d.motor.resistance_ohm, self.supply_voltage / gain);
+                let (roll, pitch, yaw) = nalgebra::Rotation3::from_matrix_unchecked(joint.origin.rotation).euler_angles();
+                let kind = match joint.kind {
+                    JointKind::Revolute => "revolute",
+                    JointKind::Prismatic => "prismatic",
+                };
+                let child = format!("{}_link", joint.name);
+                out += &format!(
+                    "  <joint name=\"{}\" type=\"{kind}\">\n    <parent link=\"{}\"/>\n    <child link=\"{}\"/>\n    <origin xyz=\"{}\" rpy=\"{}\"/>\n    <axis xyz=\"{}\"/>\n    <limit lower=\"{:?}\" upper=\"{:?}\" effort=\"{effort:?}\" velocity=\"{velocity:?}\"/>\n  </joint>\n",
+                    escape(&joint.name),
+                    escape(&parent),
+                    escape(&child),
+                    v(joint.origin.translation.as_slice()),
+                    v(&[roll, pitch, yaw]),
+                    v(joint.axis.as_slice()),
+                    joint.lower,
+                    joint.upper
+                );
+                let foot = if k == 2 { format!("    <collision>\n      <origin xyz=\"{}\" rpy=\"0 0 0\"/>\n      <geometry><sphere radius=\"{:?}\"/></geometry>\n    </collision>\n", v(leg.foot.as_slice()), leg.foot_radius) } else { String::new() };
+                out += &format!("  <link name=\"{}\">\n{}{foot}  </link>\n", escape(&child), inertial(link));
+                parent = child;
+            }
+        }
+        out + "</robot>\n"
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
