@@ -271,8 +271,9 @@ impl SerialRobot {
                 finite3(c, &jf("origin_rpy_rad"), &j.origin_rpy_rad)?;
                 finite3(c, &jf("axis"), &j.axis)?;
                 let axis = Vector3::from(j.axis);
-                if !(axis.norm() > 1e-9) {
-                    return Err(c.err(&jf("axis"), format!("{:?}", j.axis), "a zero axis", "a non-zero axis (normalized when read)"));
+                let norm = axis.norm();
+                if !(norm > 1e-9 && norm.is_finite()) {
+                    return Err(c.err(&jf("axis"), format!("{:?}", j.axis), "not a direction", "a non-zero axis of finite length (normalized when read)"));
                 }
                 c.check(j.upper > j.lower, &jf("upper"), j.upper, &format!("a value > lower = {}", j.lower))?;
                 if f.legs[0].joints.len() == 3 && j.kind != f.legs[0].joints[k].kind {
