@@ -56,16 +56,17 @@ def cli() -> None:
 
 @cli.command()
 def info() -> None:
-    """Print the engine version and the default robot description."""
+    """Print the engine version and the shipped robots (the names `scenario.robot` takes)."""
     from hexadyn import _core
 
-    robot = hexadyn.default_robot_path()
     click.echo(f"hexadyn {hexadyn.__version__}")
     click.echo(f"engine: {_core.__version__} ({_core.__file__})")
-    if robot is None:
-        click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT} (description not shipped yet)")
-    else:
-        click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT} ({robot})")
+    click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT}")
+    click.echo("shipped robots (scenario.robot):")
+    for name in _core.SHIPPED_ROBOTS:
+        p = _core.robot_properties(_core.shipped_robot_text(name), name)
+        joints = ", ".join(f"{j} ({kind})" for j, kind in p["joints"])
+        click.echo(f"  {name:<9} {p['leg_mechanism']} legs, {p['mass_kg']:.3f} kg, joints {joints}")
 
 
 def _parse_legs(ctx: click.Context, param: click.Parameter, value: str) -> tuple[int, ...]:

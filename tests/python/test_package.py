@@ -50,6 +50,8 @@ def test_cli_info():
     assert result.exit_code == 0, result.output
     assert f"engine: {_core.__version__}" in result.output
     assert "default robot: amru5" in result.output
+    assert "phantomx  serial legs, 1.843 kg, joints coxa (revolute), femur (revolute), tibia (revolute)" in result.output
+    assert "amru5     pantograph legs" in result.output
 
 
 def test_user_errors_are_one_line(monkeypatch):

@@ -15,6 +15,8 @@ mod view;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("STANDARD_GRAVITY", hexadyn::mbs::STANDARD_GRAVITY)?;
+    // The names `scenario.robot` takes for the embedded robot descriptions.
+    m.add("SHIPPED_ROBOTS", hexadyn::description::SHIPPED_ROBOTS.map(|(name, _, _)| name).to_vec())?;
     m.add_class::<mbs::PyMultibody>()?;
     m.add_class::<urdf::PyUrdfHexapod>()?;
     m.add_function(wrap_pyfunction!(urdf::shipped_robot_text, m)?)?;
