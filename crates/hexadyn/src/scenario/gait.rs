@@ -367,8 +367,6 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
 struct Stance {
     height: f64,
     workspaces: [Workspace; 6],
-    /// What `gait.body_height_m` allows, for the errors.
-    reach: String,
     /// " (the default ...)" when the height was not written.
     given: &'static str,
 }
@@ -378,11 +376,8 @@ struct Stance {
 fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_text: &'static str, clearance: f64) -> Result<Stance> {
     let height = g.body_height_m.unwrap_or(default);
     let given = if g.body_height_m.is_some() { "" } else { default_text };
-    let (lowest, highest) = legs.iter().map(|l| l.height_range()).fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (l, h)| (lo.max(l), hi.min(h)));
-    // The feet on the ground are at z = −height in the leg frame.
-    let reach = format!("a body height in ({:.4}, {:.4}) m, where the feet reach the ground (foot heights [{:.4}, {:.4}] m in the leg frame)", -highest, -lowest, lowest, highest);
     if !(height.is_finite() && height > 0.0) {
-        return Err(c.err("gait.body_height_m", height, "not a positive finite number", reach));
+        return Err(c.err("gait.body_height_m", height, "not a positive finite number", reach(legs)));
     }
     let mut workspaces: Vec<Workspace> = Vec::with_capacity(6);
     for (l, leg) in legs.iter().enumerate() {
@@ -395,7 +390,7 @@ fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_tex
         match leg.workspace(-height, -height + clearance) {
             Ok(w) => workspaces.push(w),
             // No workspace even without a clearance: the height is the problem.
-            Err(_) if leg.workspace(-height, -height).is_err() => return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach)),
+            Err(_) if leg.workspace(-height, -height).is_err() => return Err(c.err("gait.body_height_m", format!("{height}{given}"), "the feet cannot stand at this height", reach(legs))),
             Err(e) => {
                 // The largest clearance that still has a workspace, by bisection.
                 let (mut ok, mut bad) = (0.0, clearance);
@@ -411,7 +406,15 @@ fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_tex
             }
         }
     }
-    Ok(Stance { height, workspaces: workspaces.try_into().expect("six legs"), reach, given })
+    Ok(Stance { height, workspaces: workspaces.try_into().expect("six legs"), given })
+}
+
+/// What `gait.body_height_m` allows, for the errors: the heights where every foot reaches the
+/// ground (the feet on the ground are at z = −height in the leg frame). Only an error asks for
+/// it: a serial leg's height range is a search over its joint box.
+fn reach<L: Leg>(legs: &[L; 6]) -> String {
+    let (lowest, highest) = legs.iter().map(|l| l.height_range()).fold((f64::NEG_INFINITY, f64::INFINITY), |(lo, hi), (l, h)| (lo.max(l), hi.min(h)));
+    format!("a body height in ({:.4}, {:.4}) m, where the feet reach the ground (foot heights [{:.4}, {:.4}] m in the leg frame)", -highest, -lowest, lowest, highest)
 }
 
 /// A periodic gait's set-up before its legs are wrapped.
@@ -433,7 +436,7 @@ impl PeriodicWalk {
 /// steady footholds.
 #[allow(clippy::too_many_arguments)]
 fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, clearance: f64, dt: f64, duration: f64) -> Result<PeriodicWalk> {
-    let Stance { height, workspaces, reach, given } = stance;
+    let Stance { height, workspaces, given } = stance;
     let (height, workspaces) = (*height, *workspaces);
     let (cycle, period_s) = (p.cycle, p.period);
     let patterns: Vec<&GaitPattern> = std::iter::once(&p.pattern).chain(p.changes.iter().map(|ch| &ch.pattern)).collect();
@@ -478,7 +481,7 @@ fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec
     let options = GaitOptions { period: period_s, pattern: p.pattern, cycle, aep: p.aep, lift: clearance, dt };
     let footholds = steady_footholds(legs, &workspaces, height, &options, &heading.source().heading(0.0));
     let joints = joints_at(legs, &footholds)
-        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach.clone()))?;
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach(legs)))?;
     Ok(PeriodicWalk { options, heading, navigation: g.navigation, changes: p.changes, joints })
 }
 
@@ -502,7 +505,7 @@ pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 /// its workspace centre, a failed leg held up at the top of its workspace.
 #[allow(clippy::too_many_arguments)]
 fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6], stance: Stance, lift: f64, dt: f64) -> Result<GaitScenario> {
-    let Stance { height, workspaces, reach, given } = stance;
+    let Stance { height, workspaces, given } = stance;
     let default = RawFree::default();
     let raw = g.free.as_ref().unwrap_or(&default);
     let positive = |field: &str, v: Option<f64>, default: f64| -> Result<f64> {
@@ -539,7 +542,7 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6
         }
     });
     let joints = joints_at(&legs, &footholds)
-        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach))?;
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach(&legs)))?;
     let free_pattern = GaitPattern { name: "free".into(), beta: f64::NAN, offsets: [0.0; 6] };
     let periodic = GaitOptions { period: f64::NAN, pattern: free_pattern, cycle: FootCycle::Plain, aep: AepMode::Omnidirectional, lift, dt };
     let free = FreeGaitSpec { options, landing: match raw.landing {
