@@ -21,7 +21,7 @@ use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, S
 use crate::control::{joint_pis, Controller};
 use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
-use crate::description::{Robot, RobotDescription};
+use crate::description::Robot;
 
 type Result<T> = std::result::Result<T, DescriptionError>;
 
@@ -90,13 +90,13 @@ pub(super) struct RawGait {
     free: Option<RawFree>,
 }
 
-/// How the free gait detects the landings (`gait.free.landing`).
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+/// How the free gait detects the landings (`gait.free.landing`). Without the field: the motor
+/// currents on the pantograph, the normal force on serial legs.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum LandingKind {
     /// The ground force estimated from the motor currents (Section 5.6.3), as on the real
-    /// robot.
-    #[default]
+    /// robot: the pantograph's vertical joint only.
     Current,
     /// The true normal force above a threshold: the simulation mode of Section 7.7.
     Force,
@@ -109,8 +109,7 @@ struct RawFree {
     takeoff_s: Option<f64>,
     swing_s: Option<f64>,
     posture_time_s: Option<f64>,
-    #[serde(default)]
-    landing: LandingKind,
+    landing: Option<LandingKind>,
     landing_threshold_n: Option<f64>,
     failed_leg: Option<i64>,
     stability_margin_m: Option<f64>,
@@ -211,10 +210,11 @@ pub enum LandingSpec {
 
 impl LandingSpec {
     /// A fresh detector for a run of `robot` at the control period `dt` (s).
-    pub fn detector(&self, robot: &RobotDescription, dt: f64) -> Box<dyn LandingDetector> {
-        match *self {
-            LandingSpec::Current { threshold } => Box::new(MotorCurrent::new(robot, dt, threshold).expect("the scenario's validation built the legs of this robot")),
-            LandingSpec::Force { threshold } => Box::new(NormalForce { threshold }),
+    pub fn detector(&self, robot: &Robot, dt: f64) -> Box<dyn LandingDetector> {
+        match (*self, robot) {
+            (LandingSpec::Current { threshold }, Robot::Pantograph(d)) => Box::new(MotorCurrent::new(d, dt, threshold).expect("the scenario's validation built the legs of this robot")),
+            (LandingSpec::Current { .. }, Robot::Serial(_)) => unreachable!("the scenario's validation refuses landing = \"current\" on serial legs"),
+            (LandingSpec::Force { threshold }, _) => Box::new(NormalForce { threshold }),
         }
     }
 
@@ -270,16 +270,17 @@ impl GaitScenario {
     /// update.
     pub fn controller(&self, robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
         let pis = joint_pis(&robot.pi_gains(), self.options.dt);
-        match (&self.free, &self.legs, robot) {
-            (Some(free), GaitLegs::Pantograph(legs), Robot::Pantograph(d)) => {
-                let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(d, self.options.dt));
-                let (c, state) = PublishedFreeGait::new(controller);
-                (Box::new(c), state)
-            }
-            (Some(_), _, _) => unreachable!("the free gait is validated on pantograph legs only"),
-            (None, GaitLegs::Pantograph(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
-            (None, GaitLegs::Serial(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
+        match (&self.free, &self.legs) {
+            (Some(free), GaitLegs::Pantograph(legs)) => self.published(FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt))),
+            (Some(free), GaitLegs::Serial(legs)) => self.published(FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt))),
+            (None, GaitLegs::Pantograph(legs)) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
+            (None, GaitLegs::Serial(legs)) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
         }
+    }
+
+    fn published<L: Leg + Clone + 'static>(&self, controller: FreeGaitController<L>) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let (c, state) = PublishedFreeGait::new(controller);
+        (Box::new(c), state)
     }
 
     fn scheduled<L: Leg + Clone + 'static>(&self, controller: GaitController<L>) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
@@ -347,18 +348,20 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
             let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => free_gait(g, c, heading, legs, stance, clearance, dt),
-                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration).map(|w| w.on(GaitLegs::Pantograph(legs), stance)),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Current),
+                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
+            .map(|w| w.on(GaitLegs::Pantograph(legs), stance))
         }
         Robot::Serial(s) => {
             let legs = SerialLegKinematics::hexapod(&s.hexapod.legs).map_err(|e| no_kinematics(e, "serial legs with valid joint ranges"))?;
             let stance = stance(g, c, &legs, default_serial_height(&legs), " (the default: the feet with every joint at mid-range)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => Err(c.err("gait.pattern", "\"free\"", "not available on serial legs yet", "tripod, wave or equal_phase with a serial robot (the free gait's landing and posture control are written for the pantograph)")),
-                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration).map(|w| w.on(GaitLegs::Serial(legs), stance)),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Force),
+                Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
+            .map(|w| w.on(GaitLegs::Serial(legs), stance))
         }
     }
 }
@@ -417,25 +420,27 @@ fn reach<L: Leg>(legs: &[L; 6]) -> String {
     format!("a body height in ({:.4}, {:.4}) m, where the feet reach the ground (foot heights [{:.4}, {:.4}] m in the leg frame)", -highest, -lowest, lowest, highest)
 }
 
-/// A periodic gait's set-up before its legs are wrapped.
-struct PeriodicWalk {
+/// A gait's set-up before its legs are wrapped.
+struct Walking {
     options: GaitOptions,
+    /// The free gait's parameters, with `pattern = "free"`.
+    free: Option<FreeGaitSpec>,
     heading: HeadingSpec,
     navigation: bool,
     changes: Vec<GaitChange>,
     joints: [f64; JOINTS],
 }
 
-impl PeriodicWalk {
+impl Walking {
     fn on(self, legs: GaitLegs, stance: Stance) -> GaitScenario {
-        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
+        GaitScenario { options: self.options, free: self.free, heading: self.heading, navigation: self.navigation, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
     }
 }
 
 /// The periodic gait: every support stroke fits its workspace and the feet start at their
 /// steady footholds.
 #[allow(clippy::too_many_arguments)]
-fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, clearance: f64, dt: f64, duration: f64) -> Result<PeriodicWalk> {
+fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, clearance: f64, dt: f64, duration: f64) -> Result<Walking> {
     let Stance { height, workspaces, given } = stance;
     let (height, workspaces) = (*height, *workspaces);
     let (cycle, period_s) = (p.cycle, p.period);
@@ -482,7 +487,7 @@ fn periodic_gait<L: Leg>(g: &RawGait, c: &Ctx, p: Periodic, heading: HeadingSpec
     let footholds = steady_footholds(legs, &workspaces, height, &options, &heading.source().heading(0.0));
     let joints = joints_at(legs, &footholds)
         .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach(legs)))?;
-    Ok(PeriodicWalk { options, heading, navigation: g.navigation, changes: p.changes, joints })
+    Ok(Walking { options, free: None, heading, navigation: g.navigation, changes: p.changes, joints })
 }
 
 
@@ -502,10 +507,12 @@ pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
 pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 
 /// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
-/// its workspace centre, a failed leg held up at the top of its workspace.
+/// its workspace centre, a failed leg held up at the top of its workspace. `default_landing`:
+/// the landing detection without a `landing` field; serial legs (`LandingKind::Force`) refuse
+/// the motor currents, whose ground detection (Section 5.6.3) is the pantograph's.
 #[allow(clippy::too_many_arguments)]
-fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6], stance: Stance, lift: f64, dt: f64) -> Result<GaitScenario> {
-    let Stance { height, workspaces, given } = stance;
+fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, default_landing: LandingKind) -> Result<Walking> {
+    let Stance { height, workspaces, given } = *stance;
     let default = RawFree::default();
     let raw = g.free.as_ref().unwrap_or(&default);
     let positive = |field: &str, v: Option<f64>, default: f64| -> Result<f64> {
@@ -516,7 +523,14 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6
     let takeoff_time = positive("takeoff_s", raw.takeoff_s, DEFAULT_TAKEOFF_S)?;
     let swing_time = positive("swing_s", raw.swing_s, DEFAULT_SWING_S)?;
     let posture_time = positive("posture_time_s", raw.posture_time_s, DEFAULT_POSTURE_TIME_S)?;
-    let (default_threshold, allowed) = match raw.landing {
+    let landing = match (raw.landing, default_landing) {
+        (None, default) => default,
+        (Some(LandingKind::Current), LandingKind::Force) => {
+            return Err(c.err("gait.free.landing", "\"current\"", "the ground detection from the motor currents (Section 5.6.3) needs the pantograph's vertical joint", "landing = \"force\" with serial legs (the true normal force above landing_threshold_n, Section 7.7: 10 N), or no landing field"));
+        }
+        (Some(kind), _) => kind,
+    };
+    let (default_threshold, allowed) = match landing {
         LandingKind::Current => (THESIS_CURRENT_THRESHOLD, "an estimated vertical ground force > 0 N with landing = \"current\" (default 40 N, the lowest threshold of Section 5.6.3)"),
         LandingKind::Force => (THESIS_FORCE_THRESHOLD, "a normal force > 0 N with landing = \"force\" (Section 7.7: 10 N)"),
     };
@@ -541,15 +555,15 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6
             w.centre_at(-height)
         }
     });
-    let joints = joints_at(&legs, &footholds)
-        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach(&legs)))?;
+    let joints = joints_at(legs, &footholds)
+        .map_err(|l| c.err("gait.body_height_m", format!("{height}{given}"), &format!("leg {l} cannot reach its start foothold"), reach(legs)))?;
     let free_pattern = GaitPattern { name: "free".into(), beta: f64::NAN, offsets: [0.0; 6] };
     let periodic = GaitOptions { period: f64::NAN, pattern: free_pattern, cycle: FootCycle::Plain, aep: AepMode::Omnidirectional, lift, dt };
-    let free = FreeGaitSpec { options, landing: match raw.landing {
+    let free = FreeGaitSpec { options, landing: match landing {
         LandingKind::Current => LandingSpec::Current { threshold },
         LandingKind::Force => LandingSpec::Force { threshold },
     } };
-    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
+    Ok(Walking { options: periodic, free: Some(free), heading, navigation: g.navigation, changes: Vec::new(), joints })
 }
 
 /// The period, the patterns, the foot cycle and the gait changes of a periodic gait.

@@ -86,19 +86,19 @@ impl<L: Leg> Controller for ScheduledGait<L> {
 }
 
 /// The free gait controller publishing its state after each update, like [`ScheduledGait`].
-pub struct PublishedFreeGait {
-    controller: FreeGaitController,
+pub struct PublishedFreeGait<L: Leg = LegKinematics> {
+    controller: FreeGaitController<L>,
     state: Rc<RefCell<GaitState>>,
 }
 
-impl PublishedFreeGait {
-    pub fn new(controller: FreeGaitController) -> (Self, Rc<RefCell<GaitState>>) {
+impl<L: Leg> PublishedFreeGait<L> {
+    pub fn new(controller: FreeGaitController<L>) -> (Self, Rc<RefCell<GaitState>>) {
         let state = Rc::new(RefCell::new(GaitState::default()));
         (PublishedFreeGait { controller, state: state.clone() }, state)
     }
 }
 
-impl Controller for PublishedFreeGait {
+impl<L: Leg> Controller for PublishedFreeGait<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let command = self.controller.update(m);
         let c = &self.controller;

@@ -47,6 +47,12 @@ pub trait Leg: LegChain {
     fn height_range(&self) -> (f64, f64);
     /// Whether `other` reaches the same points of its leg frame (the same workspaces).
     fn same_leg_frame_reach(&self, other: &Self) -> bool;
+    /// Whether the foot reaches the point `p` of the leg frame with the joints in their
+    /// ranges: by default Eq. 7.7 from the neutral posture (with the mechanism's further
+    /// starts) ends on it.
+    fn reaches_point(&self, p: &Vector3<f64>) -> bool {
+        Leg::inverse(self, p, &self.neutral()).is_ok_and(|ik| ik.is_reached())
+    }
     /// [`inverse`] (Eq. 7.7) of a target in the leg frame from `start`.
     fn inverse(&self, target: &Vector3<f64>, start: &Vector3<f64>) -> Result<IkSolution, LegKinematicsError> {
         inverse(self, target, start)
@@ -85,6 +91,13 @@ impl Leg for LegKinematics {
     }
     fn same_leg_frame_reach(&self, other: &Self) -> bool {
         LegKinematics::same_leg_frame_reach(self, other)
+    }
+    /// In closed form: the horizontal distance of `p` from the q_r axis within the radii the
+    /// pantograph reaches at its height ([`LegKinematics::radii_at`]; q_r is taken to turn the
+    /// foot to the point's azimuth).
+    fn reaches_point(&self, p: &Vector3<f64>) -> bool {
+        let rho = p.xy().norm();
+        self.radii_at(p.z).is_some_and(|(lo, hi)| lo <= rho && rho <= hi)
     }
 }
 

@@ -24,7 +24,7 @@ use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_o
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
 use crate::control::{pi_command, Command, Controller, DigitalPi, Measurements, DIGITAL_CUTOFF_HZ};
-use crate::hexapod::{LegKinematics, Workspace, JOINTS};
+use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
 /// Security margin of the AEP inside the workspace boundary (m).
@@ -123,10 +123,11 @@ pub struct FreeGaitState {
     pub reaching_down: bool,
 }
 
-/// The free gait controller of Section 7.7.
-pub struct FreeGaitController {
+/// The free gait controller of Section 7.7, for legs of any mechanism (AMRU5's pantographs by
+/// default, [`crate::hexapod::SerialLegKinematics`] for serial legs).
+pub struct FreeGaitController<L: LegMechanism = LegKinematics> {
     pub options: FreeGaitOptions,
-    legs_kinematics: [LegKinematics; 6],
+    legs_kinematics: [L; 6],
     workspaces: [Workspace; 6],
     pis: [DigitalPi; JOINTS],
     heading: Box<dyn HeadingSource>,
@@ -145,10 +146,10 @@ pub struct FreeGaitController {
     pub diagnostics: GaitDiagnostics,
 }
 
-impl FreeGaitController {
+impl<L: LegMechanism> FreeGaitController<L> {
     pub fn new(
         options: FreeGaitOptions,
-        legs: [LegKinematics; 6],
+        legs: [L; 6],
         workspaces: [Workspace; 6],
         pis: [DigitalPi; JOINTS],
         heading: Box<dyn HeadingSource>,
@@ -202,12 +203,12 @@ impl FreeGaitController {
     /// the held-up foot of a failed rear leg touched the ground when the body leaned 5.2°
     /// towards its corner while a neighbour swung (measured with leg 4 failed): a failed leg
     /// carries no weight and needs no room to step, so nothing keeps it as low as a swinging
-    /// foot. The highest reachable point above the centre is found by bisection on the
-    /// reachable radii of the pantograph ([`LegKinematics::radii_at`]), which shrink upwards.
+    /// foot. The highest reachable point above the centre is found by bisection between the
+    /// top of the workspace and the top of the leg's reach ([`LegMechanism::reaches_point`]:
+    /// on the pantograph its reachable radii, which shrink upwards).
     fn held_up(&self, leg: usize) -> Vector3<f64> {
         let (w, kin) = (&self.workspaces[leg], &self.legs_kinematics[leg]);
-        let rho = w.centre.norm();
-        let reaches = |z: f64| kin.radii_at(z).is_some_and(|(lo, hi)| lo <= rho && rho <= hi);
+        let reaches = |z: f64| kin.reaches_point(&w.centre_at(z));
         let (mut low, mut high) = (w.z_max, self.reach_top[leg]);
         if reaches(high) {
             low = high;
@@ -413,14 +414,14 @@ impl FreeGaitController {
 /// SMC-B 28(1), 1998, for a hexapod with a locked leg). Here it is done by the footholds, so
 /// the body keeps the commanded heading: each foot lands offset in its workspace and moves
 /// along the chord through its offset centre.
-fn foothold_offsets(options: &FreeGaitOptions, legs: &[LegKinematics; 6], workspaces: &[Workspace; 6]) -> [Vector3<f64>; 6] {
+fn foothold_offsets<L: LegMechanism>(options: &FreeGaitOptions, legs: &[L; 6], workspaces: &[Workspace; 6]) -> [Vector3<f64>; 6] {
     let Some(failed) = options.failed_leg else { return [Vector3::zeros(); 6] };
     let c = legs[failed].to_body(&workspaces[failed].centre_at(-options.body_height));
     let shift = Vector3::new(c.x, c.y, 0.0) / 5.0;
     std::array::from_fn(|l| if l == failed { Vector3::zeros() } else { legs[l].direction_to_leg(&shift) })
 }
 
-impl Controller for FreeGaitController {
+impl<L: LegMechanism> Controller for FreeGaitController<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let o = self.options.clone();
         let h: Heading = self.heading.heading(m.t);
@@ -622,7 +623,7 @@ impl LegState for Leg {
     }
 }
 
-impl std::ops::Deref for FreeGaitController {
+impl<L: LegMechanism> std::ops::Deref for FreeGaitController<L> {
     type Target = Walk<Leg>;
     fn deref(&self) -> &Walk<Leg> {
         &self.walk
