@@ -115,35 +115,72 @@ pub const ROUGH_FULL_RADIUS: f64 = 1.2;
 /// range from half the foot spacing to several robot lengths, so the feet meet both bumps and
 /// inclines.
 pub fn rough(rms: f64, seed: u64) -> Triangles {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let waves: Vec<(f64, f64, f64)> = (0..64)
-        .map(|_| {
-            let direction = rng.random_range(0.0..std::f64::consts::TAU);
-            let wavelength = rng.random_range(0.3..3.0);
-            let k = std::f64::consts::TAU / wavelength;
-            (k * direction.cos(), k * direction.sin(), rng.random_range(0.0..std::f64::consts::TAU))
-        })
-        .collect();
-    // Each unit cosine has mean square 1/2: the sum of 64 has RMS 4 (independent phases).
-    let scale = rms / (waves.len() as f64 / 2.0).sqrt();
-    let fade = |r: f64| {
-        let u = ((r - ROUGH_FLAT_RADIUS) / (ROUGH_FULL_RADIUS - ROUGH_FLAT_RADIUS)).clamp(0.0, 1.0);
-        u * u * (3.0 - 2.0 * u)
-    };
-    let (spacing, origin, (nx, ny)) = (0.1, [-2.0, -6.0], (161, 121));
-    let heights: Vec<Vec<f64>> = (0..ny)
-        .map(|j| {
-            (0..nx)
-                .map(|i| {
-                    let (x, y) = (origin[0] + i as f64 * spacing, origin[1] + j as f64 * spacing);
-                    let z: f64 = waves.iter().map(|&(kx, ky, phase)| (kx * x + ky * y + phase).cos()).sum();
-                    scale * z * fade(x.hypot(y))
-                })
-                .collect()
-        })
-        .collect();
-    grid_triangles(origin, spacing, &heights)
+    RoughGround { rms, seed, length_scale: 1.0, flat_radius: ROUGH_FLAT_RADIUS, full_radius: ROUGH_FULL_RADIUS }.triangles()
 }
+
+/// The parameters of a [`rough`] ground for a robot of another size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughGround {
+    /// RMS height (m).
+    pub rms: f64,
+    /// Seed of the waves' directions, wavelengths and phases.
+    pub seed: u64,
+    /// Factor on every horizontal length of [`rough`]: the grid spacing, the field and the
+    /// wavelengths (1: AMRU5's ground).
+    pub length_scale: f64,
+    /// Radius around the origin within which the ground is flat, and beyond which it has its
+    /// full roughness (m).
+    pub flat_radius: f64,
+    pub full_radius: f64,
+}
+
+impl RoughGround {
+    /// The ground of [`rough`] with these parameters.
+    pub fn triangles(&self) -> Triangles {
+        let (rms, s) = (self.rms, self.length_scale);
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        let waves: Vec<(f64, f64, f64)> = (0..64)
+            .map(|_| {
+                let direction = rng.random_range(0.0..std::f64::consts::TAU);
+                let wavelength = rng.random_range(0.3 * s..3.0 * s);
+                let k = std::f64::consts::TAU / wavelength;
+                (k * direction.cos(), k * direction.sin(), rng.random_range(0.0..std::f64::consts::TAU))
+            })
+            .collect();
+        // Each unit cosine has mean square 1/2: the sum of 64 has RMS 4 (independent phases).
+        let scale = rms / (waves.len() as f64 / 2.0).sqrt();
+        let (flat, full) = (self.flat_radius, self.full_radius);
+        let fade = |r: f64| {
+            let u = ((r - flat) / (full - flat)).clamp(0.0, 1.0);
+            u * u * (3.0 - 2.0 * u)
+        };
+        let (spacing, origin, (nx, ny)) = (0.1 * s, [-2.0 * s, -6.0 * s], (161, 121));
+        let heights: Vec<Vec<f64>> = (0..ny)
+            .map(|j| {
+                (0..nx)
+                    .map(|i| {
+                        let (x, y) = (origin[0] + i as f64 * spacing, origin[1] + j as f64 * spacing);
+                        let z: f64 = waves.iter().map(|&(kx, ky, phase)| (kx * x + ky * y + phase).cos()).sum();
+                        scale * z * fade(x.hypot(y))
+                    })
+                    .collect()
+            })
+            .collect();
+        grid_triangles(origin, spacing, &heights)
+    }
+}
+
+/// The rough ground of the PhantomX Mark II's free gait (`phantomx_free_gait_rough.toml`):
+/// AMRU5's ([`rough`], seed 7) a third of its size, 0.5 cm RMS over wavelengths of 0.1-1 m on
+/// a 3.3 cm grid (a 5.3 m × 4 m field), flat within 0.3 m of the origin, fully rough beyond
+/// 0.6 m.
+///
+/// INTERPRETATION: the PhantomX stands about three times lower than AMRU5 (body 0.12 m above
+/// the ground against 0.41 m) and lifts its feet 3 cm (AMRU5 4.5 cm on rough ground): the
+/// heights and the wavelengths are scaled by 1/3 (1.5 cm RMS → 0.5 cm; the shortest wavelength
+/// stays about half the foot spacing). Its feet stand up to about 0.25 m from the body centre
+/// (AMRU5 0.54 m): flat within 0.3 m, with AMRU5's fade to twice that radius.
+pub const PHANTOMX_ROUGH: RoughGround = RoughGround { rms: 0.005, seed: 7, length_scale: 1.0 / 3.0, flat_radius: 0.3, full_radius: 0.6 };
 
 /// The format of the shipped files: binary little endian with float coordinates, as Blender
 /// exports.
@@ -151,5 +188,10 @@ pub const SHIPPED_FORMAT: PlyFormat = PlyFormat { encoding: Encoding::BinaryLitt
 
 /// The shipped terrains, by file name.
 pub fn shipped() -> Vec<(&'static str, Triangles)> {
-    vec![("step_8cm.ply", step_block(0.08)), ("slope_20deg.ply", ramp(20f64.to_radians())), ("rough_ground.ply", rough(0.015, 7))]
+    vec![
+        ("step_8cm.ply", step_block(0.08)),
+        ("slope_20deg.ply", ramp(20f64.to_radians())),
+        ("rough_ground.ply", rough(0.015, 7)),
+        ("rough_ground_phantomx.ply", PHANTOMX_ROUGH.triangles()),
+    ]
 }

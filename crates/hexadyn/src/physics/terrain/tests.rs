@@ -306,6 +306,15 @@ fn shipped_terrains_have_the_geometry_of_section_7_7_5() {
     let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64).sqrt();
     assert!((rms - 0.015).abs() < 0.003, "RMS {rms}");
     assert!(rough.vertices.iter().filter(|v| v[0].hypot(v[1]) < 0.6).all(|v| v[2] == 0.0));
+    // The PhantomX's: a third of it, 5 mm RMS beyond 0.6 m, flat within 0.3 m, the field a
+    // third of AMRU5's.
+    let small = generate::PHANTOMX_ROUGH.triangles();
+    let z: Vec<f64> = small.vertices.iter().filter(|v| v[0].hypot(v[1]) > 0.6).map(|v| v[2]).collect();
+    let rms = (z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64).sqrt();
+    assert!((rms - 0.005).abs() < 0.001, "RMS {rms}");
+    assert!(small.vertices.iter().filter(|v| v[0].hypot(v[1]) < 0.3).all(|v| v[2] == 0.0));
+    let x_max = small.vertices.iter().map(|v| v[0]).fold(f64::NEG_INFINITY, f64::max);
+    assert!((x_max - 14.0 / 3.0).abs() < 1e-9, "{x_max}");
 }
 
 /// A ridge of two faces, z = 0.1 - 0.2 |x| near x = 0 (slope angle θ/2 = atan 0.2 each side),
