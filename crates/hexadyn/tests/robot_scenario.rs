@@ -452,6 +452,14 @@ fn walking_scenarios_parse() {
     assert_eq!(landing(&with("free_gait_slope_square", "landing_threshold_n = 10.0\n", "")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_straight", "landing = \"current\"", "landing = \"force\"").replace("landing_threshold_n = 40.0", "")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_slope_square", "landing = \"force\"\nlanding_threshold_n = 10.0\n", "")), LandingSpec::Current { threshold: 40.0 });
+    // On serial legs the normal force, also without the field (the currents' detection of
+    // Section 5.6.3 is the pantograph's).
+    let px = "phantomx_free_gait_rough";
+    let terrain = format!("file = \"{}/terrains/", scenarios_dir().display());
+    let px_with = |from: &str, to: &str| with(px, from, to).replace("file = \"terrains/", &terrain);
+    assert_eq!(landing(&px_with("", "")), LandingSpec::Force { threshold: 0.54 });
+    assert_eq!(landing(&px_with("landing = \"force\"", "")), LandingSpec::Force { threshold: 0.54 });
+    assert_eq!(landing(&px_with("landing = \"force\"", "").replace("landing_threshold_n = 0.54", "")), LandingSpec::Force { threshold: 10.0 });
 
     // Waypoints of a spline.
     let text = with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 50.0, 100.0]\nx_m = [0.0, 0.5, 1.0]\ny_m = [0.0, 0.2, 0.0]");
@@ -529,6 +537,14 @@ fn gait_errors_name_the_field() {
     assert!(s.contains("<missing>") && s.contains("[gait]"), "{s}");
     let s = field_error(&with(v, "mode = \"gait\"", "mode = \"gait\"\n[[control.motion]]\nleg = 0\njoint = \"q_v\"\nkind = \"sine\"\namplitude = 0.001\nfrequency_hz = 1.0"), "control.motion");
     assert!(s.contains("mode = \"pi\""), "{s}");
+
+    // The free gait on serial legs: the landing from the motor currents is the pantograph's.
+    let px = "phantomx_free_gait_rough";
+    let text = with(px, "landing = \"force\"", "landing = \"current\"").replace("file = \"terrains/", &format!("file = \"{}/terrains/", scenarios_dir().display()));
+    let s = field_error(&text, "gait.free.landing");
+    assert!(s.contains("\"current\"") && s.contains("landing = \"force\"") && s.contains("serial"), "{s}");
+    let line = shipped(px).lines().position(|l| l.starts_with("landing =")).unwrap() + 1;
+    assert!(s.starts_with(&format!("bad.toml:{line}:")), "{s}");
 }
 
 /// A heading from a CSV file next to the scenario; a malformed file is reported with its line.
