@@ -137,6 +137,8 @@ pub struct FreeGaitController<L: LegMechanism = LegKinematics> {
     foothold_offset: [Vector3<f64>; 6],
     /// Highest foot of each leg's reach (leg frame, m).
     reach_top: [f64; 6],
+    /// Where the failed leg's foot is held ([`held_up`]), found once (leg frame).
+    held_up: Option<Vector3<f64>>,
     walk: Walk<Leg>,
     /// Body-frame posture velocities (v_z, ω_x, ω_y) of Eq. 7.35-7.37 and when they end.
     posture: (Vector3<f64>, f64),
@@ -159,7 +161,8 @@ impl<L: LegMechanism> FreeGaitController<L> {
         let idle = Leg { phase: FootPhase::Support, anchor: z, contact: z, elapsed: 0.0, pep: z, swing_time: options.swing_time, rise_to: None, descent: 0.0, resisted: 0.0, foot: z, joints: z };
         let neighbours = neighbours(options.failed_leg);
         let foothold_offset = foothold_offsets(&options, &legs, &workspaces);
-        let reach_top = std::array::from_fn(|l| legs[l].height_range().1);
+        let reach_top: [f64; 6] = std::array::from_fn(|l| legs[l].height_range().1);
+        let held_up = options.failed_leg.map(|l| held_up(&legs[l], &workspaces[l], reach_top[l]));
         FreeGaitController {
             options,
             legs_kinematics: legs,
@@ -170,6 +173,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
             neighbours,
             foothold_offset,
             reach_top,
+            held_up,
             walk: Walk { body: None, legs: [idle; 6] },
             posture: (z, f64::NEG_INFINITY),
             sway: None,
@@ -193,31 +197,6 @@ impl<L: LegMechanism> FreeGaitController<L> {
 
     fn leg_frame(&self, leg: usize, body: &Htm) -> Htm {
         body.compose(&self.legs_kinematics[leg].body_from_leg())
-    }
-
-    /// Where a failed leg is held: above its workspace centre, as high as the leg reaches there
-    /// less the security margin of the working volume ([`AEP_SECURITY`]).
-    ///
-    /// INTERPRETATION (beyond the thesis): "held up" is read as high as the leg can be held. At
-    /// the top of the workspace, the height of a foot in the air (one lift above the ground),
-    /// the held-up foot of a failed rear leg touched the ground when the body leaned 5.2°
-    /// towards its corner while a neighbour swung (measured with leg 4 failed): a failed leg
-    /// carries no weight and needs no room to step, so nothing keeps it as low as a swinging
-    /// foot. The highest reachable point above the centre is found by bisection between the
-    /// top of the workspace and the top of the leg's reach ([`LegMechanism::reaches_point`]:
-    /// on the pantograph its reachable radii, which shrink upwards).
-    fn held_up(&self, leg: usize) -> Vector3<f64> {
-        let (w, kin) = (&self.workspaces[leg], &self.legs_kinematics[leg]);
-        let reaches = |z: f64| kin.reaches_point(&w.centre_at(z));
-        let (mut low, mut high) = (w.z_max, self.reach_top[leg]);
-        if reaches(high) {
-            low = high;
-        }
-        while high - low > 1e-6 {
-            let mid = 0.5 * (low + high);
-            if reaches(mid) { low = mid } else { high = mid }
-        }
-        w.centre_at((low - AEP_SECURITY).max(w.z_max))
     }
 
     /// First update: the body pose (navigation, or level with the body frame at the mean foot
@@ -398,6 +377,32 @@ impl<L: LegMechanism> FreeGaitController<L> {
     }
 }
 
+/// Where a failed leg is held: above its workspace centre `w`, as high as the leg reaches there
+/// (below `reach_top`, the top of its reach) less the security margin of the working volume
+/// ([`AEP_SECURITY`]).
+///
+/// INTERPRETATION (beyond the thesis): "held up" is read as high as the leg can be held. At
+/// the top of the workspace, the height of a foot in the air (one lift above the ground),
+/// the held-up foot of a failed rear leg touched the ground when the body leaned 5.2°
+/// towards its corner while a neighbour swung (measured with leg 4 failed): a failed leg
+/// carries no weight and needs no room to step, so nothing keeps it as low as a swinging
+/// foot. The highest reachable point above the centre is found by bisection between the
+/// top of the workspace and the top of the leg's reach ([`LegMechanism::reaches_point`]:
+/// on the pantograph its reachable radii, which shrink upwards; on a serial leg Eq. 7.7, so
+/// the point is found once, not at every control instant).
+fn held_up<L: LegMechanism>(kin: &L, w: &Workspace, reach_top: f64) -> Vector3<f64> {
+    let reaches = |z: f64| kin.reaches_point(&w.centre_at(z));
+    let (mut low, mut high) = (w.z_max, reach_top);
+    if reaches(high) {
+        low = high;
+    }
+    while high - low > 1e-6 {
+        let mid = 0.5 * (low + high);
+        if reaches(mid) { low = mid } else { high = mid }
+    }
+    w.centre_at((low - AEP_SECURITY).max(w.z_max))
+}
+
 /// Beyond the thesis: with a failed leg, the footholds of the five working legs are offset
 /// towards the failed leg by a fifth of its workspace centre's horizontal distance from the body
 /// centre (body frame), so that the body centre stands over the centroid of the five workspace
@@ -494,7 +499,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             let v_c = centre_velocity(&self.legs_kinematics[l], &c, &frame_desired, &desired, &h);
             leg.elapsed += o.dt;
             leg.foot = if !self.working(l) {
-                self.held_up(l)
+                self.held_up.expect("found for the failed leg")
             } else {
                 match leg.phase {
                     // Eq. 7.11.
