@@ -40,7 +40,7 @@ def read_binary_ply(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 def test_shipped_terrains_are_package_data():
     names = sorted(p.name for p in TERRAINS.glob("*.ply"))
-    assert names == ["rough_ground.ply", "slope_20deg.ply", "step_8cm.ply"]
+    assert names == ["rough_ground.ply", "rough_ground_phantomx.ply", "slope_20deg.ply", "step_8cm.ply"]
 
 
 def test_mesh_terrain_triangles_are_those_of_the_file():
@@ -55,6 +55,13 @@ def test_mesh_terrain_triangles_are_those_of_the_file():
     r = np.hypot(vertices[:, 0], vertices[:, 1])
     assert np.all(vertices[r < 0.6, 2] == 0)
     assert abs(np.sqrt(np.mean(vertices[r > 1.2, 2] ** 2)) - 0.015) < 0.003
+    # The PhantomX's (phantomx_free_gait_rough): the same ground at a third of its size, flat
+    # within 0.3 m of the start, 0.5 cm RMS beyond 0.6 m.
+    vertices, faces = _core.terrain_triangles(str(hexadyn.SCENARIOS_DIR / "phantomx_free_gait_rough.toml"))
+    assert faces.shape == (38400, 3)
+    r = np.hypot(vertices[:, 0], vertices[:, 1])
+    assert np.all(vertices[r < 0.3, 2] == 0)
+    assert abs(np.sqrt(np.mean(vertices[r > 0.6, 2] ** 2)) - 0.005) < 0.001
 
 
 def test_analytic_grounds_are_squares(tmp_path: Path):
