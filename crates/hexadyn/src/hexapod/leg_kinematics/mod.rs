@@ -407,6 +407,40 @@ pub(super) mod tests {
         }
     }
 
+    /// The pantograph's closed-form `Leg::reaches_point` (its reachable radii at the point's
+    /// height) agrees with the trait's default, Eq. 7.7 from the neutral posture, on the
+    /// vertical through the workspace centre where the free gait holds a failed leg: the highest
+    /// point each finds by bisection within 1 mm (a tenth of the security margin the held-up
+    /// foot keeps below it; measured 0.11 mm: near the edge of the reach Eq. 7.7's Newton
+    /// iterations stop short of its 1e-12 m tolerance), and the same answer at heights farther
+    /// than that from it.
+    #[test]
+    fn reaches_point_in_closed_form_is_the_inverse_kinematics() {
+        use super::inverse::Leg as _;
+        for leg in amru5().iter() {
+            let w = neutral_workspace(leg);
+            let by_ik = |p: &Vector3<f64>| inverse(leg, p, &leg.neutral()).is_ok_and(|ik| ik.is_reached());
+            let top = leg.height_range().1;
+            let highest = |reaches: &dyn Fn(&Vector3<f64>) -> bool| {
+                let (mut low, mut high) = (w.z_max, top);
+                assert!(reaches(&w.centre_at(low)));
+                while high - low > 1e-7 {
+                    let mid = 0.5 * (low + high);
+                    if reaches(&w.centre_at(mid)) { low = mid } else { high = mid }
+                }
+                low
+            };
+            let (closed, ik) = (highest(&|p| leg.reaches_point(p)), highest(&by_ik));
+            assert!((closed - ik).abs() < 1e-3, "highest reach {closed} m in closed form, {ik} m by Eq. 7.7");
+            for k in 0..=40 {
+                let z = w.z_min + (top + 0.02 - w.z_min) * k as f64 / 40.0;
+                if (z - closed).abs() > 1e-3 {
+                    assert_eq!(leg.reaches_point(&w.centre_at(z)), by_ik(&w.centre_at(z)), "z = {z}");
+                }
+            }
+        }
+    }
+
     /// Ranges where the pantograph cannot close are refused when the leg is built.
     #[test]
     fn leg_kinematics_refuses_open_linkages() {

@@ -334,8 +334,8 @@ mod tests {
     }
 
     /// The workspace at the height of the foot at mid-range: every point of the cylinder is
-    /// reached (Eq. 7.7 from the middle of the ranges), and a cylinder 3 mm wider about the same
-    /// axis is not.
+    /// reached (Eq. 7.7 from the middle of the ranges, as `Leg::reaches_point` finds), and a
+    /// cylinder 3 mm wider about the same axis is not.
     #[test]
     fn the_workspace_is_reachable_and_maximal() {
         let robot = robot();
@@ -348,12 +348,14 @@ mod tests {
             for _ in 0..200 {
                 let (a, rho, h): (f64, f64, f64) = (r.random_range(0.0..std::f64::consts::TAU), w.radius * r.random::<f64>().sqrt(), r.random_range(w.z_min..=w.z_max));
                 let p = Vector3::new(w.centre.x + rho * a.cos(), w.centre.y + rho * a.sin(), h);
-                assert!(kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached(), "{p:?} in {w:?}");
+                assert!(kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached() && kin.reaches_point(&p), "{p:?} in {w:?}");
             }
             let wider = (0..64).map(|k| std::f64::consts::TAU * k as f64 / 64.0).any(|a| {
                 [w.z_min, w.z_max, (w.z_min + w.z_max) / 2.0].iter().any(|&h| {
                     let p = Vector3::new(w.centre.x + (w.radius + 0.003) * a.cos(), w.centre.y + (w.radius + 0.003) * a.sin(), h);
-                    !kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached()
+                    let reached = kin.inverse(&p, &kin.limits().middle()).unwrap().is_reached();
+                    assert_eq!(reached, kin.reaches_point(&p), "{p:?}");
+                    !reached
                 })
             });
             assert!(wider, "a cylinder 3 mm wider than {w:?} is reached everywhere");
