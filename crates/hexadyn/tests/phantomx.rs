@@ -97,19 +97,42 @@ fn number(s: &Summary, key: &str) -> f64 {
 }
 
 /// The shipped walks of the issue: 0 clamped IK references, the energy account closed within
-/// 0.1 % of the electrical energy, and the body where the gait took it.
+/// 0.1 % of the electrical energy, the body where the gait took it (within 3 %: the feet slip
+/// and the servos lag at the stops) and, with a navigation system, on its path within 3 mm.
 #[test]
 fn the_shipped_walks_walk() {
-    for (name, advance) in [("phantomx_tripod", 0.7), ("phantomx_wave", 0.7), ("phantomx_spline", 0.97)] {
+    for name in ["phantomx_tripod", "phantomx_wave", "phantomx_spline"] {
         let s = Scenario::from_file(root().join(format!("python/hexadyn/scenarios/{name}.toml"))).unwrap();
         let r = run_scenario(&s, |_| {}).unwrap();
         let summary = &r.summary;
         let (walked, reference) = (number(summary, "distance_walked_m"), number(summary, "reference_distance_m"));
         let balance = number(summary, "energy_balance_error_relative");
         let clamped = number(summary, "clamped_ik_references");
-        println!("{name}: walked {walked:.4} m of {reference:.4} m, balance {balance:.2e}, clamped {clamped}, path error {:.4} m", number(summary, "tracking_error_xy_max_m"));
+        let path = number(summary, "tracking_error_xy_max_m");
+        println!("{name}: walked {walked:.4} m of {reference:.4} m, balance {balance:.2e}, clamped {clamped}, path error {path:.4} m");
         assert_eq!(clamped, 0.0, "{name}");
         assert!(balance.abs() < 1e-3, "{name}: energy balance {balance}");
-        assert!(walked > advance * reference, "{name}: {walked} m of {reference} m");
+        assert!((walked / reference - 1.0).abs() < 0.03, "{name}: {walked} m of {reference} m");
+        if s.gait.as_ref().is_some_and(|g| g.navigation) {
+            assert!(path < 3e-3, "{name}: path error {path} m");
+        }
     }
+}
+
+/// The friction feed-forward of the master takes out the lag a servo's dry friction leaves:
+/// without it the AX-12A's 0.59 N m gear friction, which its compliance law balances only
+/// 3.2 degrees from the goal, holds each joint until the goal has moved that far, and the
+/// tripod walks a fifth less than commanded.
+#[test]
+fn the_friction_feedforward_takes_out_the_servo_lag() {
+    let text = std::fs::read_to_string(root().join("python/hexadyn/scenarios/phantomx_tripod.toml")).unwrap();
+    assert!(text.contains("friction_feedforward = true"));
+    let walked = |text: &str| {
+        let s = Scenario::from_str(text, "phantomx_tripod.toml", &root().join("python/hexadyn/scenarios")).unwrap();
+        let r = run_scenario(&s, |_| {}).unwrap();
+        number(&r.summary, "distance_walked_m") / number(&r.summary, "reference_distance_m")
+    };
+    let (with, without) = (walked(&text), walked(&text.replace("friction_feedforward = true", "friction_feedforward = false")));
+    println!("tripod with the feed-forward {with:.4}, without {without:.4} of the commanded distance");
+    assert!(with > 0.97 && without < 0.9, "with {with}, without {without}");
 }

@@ -15,7 +15,7 @@ use serde::Deserialize;
 
 use super::tables::GroundTable;
 use super::PiGains;
-use crate::control::{Encoder, PositionServo};
+use crate::control::{Encoder, FrictionFeedForward, PositionServo};
 use crate::fields::{Bound, Ctx, Finite, NonNegative, Positive, Result};
 use crate::hexapod::{JointKind, LegJoints, Link, Rotor, SerialHexapod, SerialJoint, SerialLeg, JOINTS, LEG_COUNT};
 use crate::physics::{DcMotor, DryViscous, FrictionElement, GroundContact, JointFriction, LuGre, SteadyState};
@@ -372,6 +372,18 @@ impl SerialRobot {
     /// Whether the motors are driven by position servos (the inputs are goal positions).
     pub fn has_servos(&self) -> bool {
         self.drives.iter().all(|d| matches!(d.control, DriveControl::Servo(_)))
+    }
+
+    /// The master's friction feed-forward for the servos ([`FrictionFeedForward`]; None
+    /// without servos) at the control period `dt`: per joint the voltage whose stall torque is
+    /// the drive's dry friction, τ_f,d R / (n k_t) (Eq. 4.4-4.6 at q' = 0), and the linear zone
+    /// ε of its friction law.
+    pub fn friction_feedforward(&self, dt: f64) -> Option<FrictionFeedForward> {
+        let voltage = |k: usize| {
+            let d = self.drive(k);
+            d.friction.tau_f_d * d.motor.resistance_ohm / (d.gear_ratio * d.motor.torque_constant_nm_per_a)
+        };
+        self.has_servos().then(|| FrictionFeedForward::new(std::array::from_fn(|k| self.servo(k)), std::array::from_fn(voltage), std::array::from_fn(|k| self.drive(k).friction.linear_zone), dt))
     }
 
     fn servo(&self, k: usize) -> PositionServo {

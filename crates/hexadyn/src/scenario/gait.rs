@@ -83,6 +83,8 @@ pub(super) struct RawGait {
     clearance_m: Option<f64>,
     #[serde(default)]
     navigation: bool,
+    #[serde(default)]
+    friction_feedforward: bool,
     body_height_m: Option<f64>,
     heading: RawHeading,
     #[serde(default)]
@@ -245,6 +247,9 @@ pub struct GaitScenario {
     pub heading: HeadingSpec,
     /// Whether the controller receives the true body pose.
     pub navigation: bool,
+    /// Whether the master adds the friction feed-forward to its servo goals
+    /// ([`crate::control::FrictionFeedForward`]; servo robots only).
+    pub friction_feedforward: bool,
     /// Height of the body frame above the ground the workspaces are computed for (m).
     pub body_height: f64,
     pub legs: GaitLegs,
@@ -278,7 +283,11 @@ impl GaitScenario {
             }
             (Some(_), _, _) => unreachable!("the free gait is validated on pantograph legs only"),
             (None, GaitLegs::Pantograph(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
-            (None, GaitLegs::Serial(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
+            (None, GaitLegs::Serial(legs), _) => {
+                let controller = GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source());
+                let feedforward = robot.friction_feedforward(self.options.dt).filter(|_| self.friction_feedforward);
+                self.scheduled(controller.with_friction_feedforward(feedforward))
+            }
         }
     }
 
@@ -341,7 +350,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
     let heading = || validate_heading(&g.heading, c, dir);
     let no_kinematics = |e: LegKinematicsError, what: &str| c.err("scenario.robot", robot.origin(), &format!("no leg kinematics: {e}"), what);
 
-    match robot {
+    let gait = match robot {
         Robot::Pantograph(d) => {
             let legs = LegKinematics::hexapod_from_description(d).map_err(|e| no_kinematics(e, "a robot description whose pantograph closes over the joint ranges"))?;
             let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
@@ -360,7 +369,11 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
                 Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration).map(|w| w.on(GaitLegs::Serial(legs), stance)),
             }
         }
+    }?;
+    if g.friction_feedforward && robot.friction_feedforward(dt).is_none() {
+        return Err(c.err("gait.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)"));
     }
+    Ok(GaitScenario { friction_feedforward: g.friction_feedforward, ..gait })
 }
 
 /// The body height of a gait and the workspace cylinders of the legs at it.
@@ -428,7 +441,7 @@ struct PeriodicWalk {
 
 impl PeriodicWalk {
     fn on(self, legs: GaitLegs, stance: Stance) -> GaitScenario {
-        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
+        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, friction_feedforward: false, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
     }
 }
 
@@ -549,7 +562,7 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6
         LandingKind::Current => LandingSpec::Current { threshold },
         LandingKind::Force => LandingSpec::Force { threshold },
     } };
-    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
+    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, friction_feedforward: false, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
 }
 
 /// The period, the patterns, the foot cycle and the gait changes of a periodic gait.
