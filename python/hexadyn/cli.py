@@ -383,6 +383,17 @@ def export_urdf_command(robot: str, out_file: Path, overwrite: bool) -> None:
     click.echo(f"URDF: {export_urdf(robot, out_file, overwrite)}")
 
 
+@cli.command("export-mjcf")
+@click.argument("robot")
+@click.argument("out_file", type=click.Path(path_type=Path))
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+def export_mjcf_command(robot: str, out_file: Path, overwrite: bool) -> None:
+    """Write a robot (shipped name or description file, either leg mechanism) as MuJoCo MJCF."""
+    from hexadyn.urdf import export_mjcf
+
+    click.echo(f"MJCF: {export_mjcf(robot, out_file, overwrite)}")
+
+
 @cli.command("urdf")
 @click.argument("urdf_file", type=click.Path(path_type=Path))
 @click.option("--height", type=float, default=None, help="Body height (m) for the workspaces [default: feet on the ground with the joints mid-range].")
