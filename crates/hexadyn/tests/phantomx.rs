@@ -167,6 +167,9 @@ fn joint_friction_overrides_the_drive_friction_of_a_serial_joint() {
     assert_eq!(b.drives[0].friction.sigma_0, 1000.0);
     assert_eq!((b.drives[0].friction.tau_f_d, b.drives[2].friction.tau_f_d, b.drives[1].friction.f_v), (a.drives[0].friction.tau_f_d, a.drives[2].friction.tau_f_d, a.drives[1].friction.f_v));
     assert_eq!(b.drives[1].friction.linear_zone, a.drives[1].friction.linear_zone);
+    // The master's friction feed-forward is the robot's as described, not the override's.
+    assert_eq!(s.gait.as_ref().unwrap().friction_feedforward, plain.gait.as_ref().unwrap().friction_feedforward);
+    assert!(plain.gait.as_ref().unwrap().friction_feedforward.is_some());
     // The effective text reads back the same.
     let again = Scenario::from_str(&s.text, "effective.toml", &root().join("python/hexadyn/scenarios")).unwrap();
     assert_eq!(serial(&again).drives, b.drives);

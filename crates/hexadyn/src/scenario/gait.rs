@@ -18,7 +18,7 @@ use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDet
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
-use crate::control::{joint_pis, Controller};
+use crate::control::{joint_pis, Controller, FrictionFeedForward};
 use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::{Robot, RobotDescription};
@@ -247,9 +247,11 @@ pub struct GaitScenario {
     pub heading: HeadingSpec,
     /// Whether the controller receives the true body pose.
     pub navigation: bool,
-    /// Whether the master adds the friction feed-forward to its servo goals
-    /// ([`crate::control::FrictionFeedForward`]; servo robots only).
-    pub friction_feedforward: bool,
+    /// The friction feed-forward the master adds to its servo goals
+    /// ([`crate::control::FrictionFeedForward`]; servo robots only), built from the robot as its
+    /// file describes it: the friction the master knows, not a `[model.joint_friction]`
+    /// override (a Monte Carlo draw).
+    pub friction_feedforward: Option<FrictionFeedForward>,
     /// Height of the body frame above the ground the workspaces are computed for (m).
     pub body_height: f64,
     pub legs: GaitLegs,
@@ -285,8 +287,7 @@ impl GaitScenario {
             (None, GaitLegs::Pantograph(legs), _) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
             (None, GaitLegs::Serial(legs), _) => {
                 let controller = GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source());
-                let feedforward = robot.friction_feedforward(self.options.dt).filter(|_| self.friction_feedforward);
-                self.scheduled(controller.with_friction_feedforward(feedforward))
+                self.scheduled(controller.with_friction_feedforward(self.friction_feedforward.clone()))
             }
         }
     }
@@ -332,7 +333,10 @@ fn duty_factor(c: &Ctx, field: &str, kind: GaitKind, value: Option<f64>, cycle: 
 }
 
 /// Validates the `[gait]` table. `duration` is the scenario's (s).
-pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
+///
+/// `described` is the robot as its file describes it, before the scenario's friction
+/// overrides: the master's friction feed-forward is built from it.
+pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
     let dt = robot.period();
     let periodic = match g.pattern.periodic() {
         Some(kind) => Some(periodic_pattern(g, c, kind, dt, duration)?),
@@ -370,10 +374,12 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
             }
         }
     }?;
-    if g.friction_feedforward && robot.friction_feedforward(dt).is_none() {
-        return Err(c.err("gait.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)"));
-    }
-    Ok(GaitScenario { friction_feedforward: g.friction_feedforward, ..gait })
+    let friction_feedforward = match (g.friction_feedforward, described.friction_feedforward(dt)) {
+        (false, _) => None,
+        (true, Some(f)) => Some(f),
+        (true, None) => return Err(c.err("gait.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)")),
+    };
+    Ok(GaitScenario { friction_feedforward, ..gait })
 }
 
 /// The body height of a gait and the workspace cylinders of the legs at it.
@@ -441,7 +447,7 @@ struct PeriodicWalk {
 
 impl PeriodicWalk {
     fn on(self, legs: GaitLegs, stance: Stance) -> GaitScenario {
-        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, friction_feedforward: false, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
+        GaitScenario { options: self.options, free: None, heading: self.heading, navigation: self.navigation, friction_feedforward: None, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
     }
 }
 
@@ -562,7 +568,7 @@ fn free_gait(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: [LegKinematics; 6
         LandingKind::Current => LandingSpec::Current { threshold },
         LandingKind::Force => LandingSpec::Force { threshold },
     } };
-    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, friction_feedforward: false, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
+    Ok(GaitScenario { options: periodic, free: Some(free), heading, navigation: g.navigation, friction_feedforward: None, body_height: height, legs: GaitLegs::Pantograph(legs), workspaces, changes: Vec::new(), joints })
 }
 
 /// The period, the patterns, the foot cycle and the gait changes of a periodic gait.
