@@ -20,6 +20,21 @@ def rates_to_body(pitch: float, roll: float) -> np.ndarray:
     return np.array([[-sp, 0.0, 1.0], [cp * sr, cr, 0.0], [cp * cr, -sr, 0.0]])
 
 
+def record_errors(model, data, ours, q: np.ndarray, g: np.ndarray, worst: dict) -> None:
+    """Raises `worst` to the relative errors of hexadyn's feet, mass matrix and gravity forces
+    at q against MuJoCo's at `data` (after mj_forward, qvel = 0), reduced to hexadyn's
+    coordinates through MuJoCo's qvel = G q': M = Gᵀ M_MuJoCo G, g = −Gᵀ bias."""
+    m = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, m)
+    feet = np.array([data.site(f"foot{leg}").xpos for leg in range(6)])
+    for key, theirs, mine in (
+        ("feet", feet, ours.feet(q)),
+        ("M", g.T @ m @ g, ours.mass_matrix(q)),
+        ("g", -g.T @ data.qfrc_bias, ours.gravity_forces(q)),
+    ):
+        worst[key] = max(worst[key], np.abs(mine - theirs).max() / np.abs(theirs).max())
+
+
 def test_the_exported_robot_is_the_same_in_mujoco():
     rng = np.random.default_rng(21)
     worst = {"feet": 0.0, "M": 0.0, "g": 0.0, "mass": 0.0}
@@ -38,18 +53,10 @@ def test_the_exported_robot_is_the_same_in_mujoco():
             data.qpos[:] = np.concatenate([q[:3], [w, x, y, z], q[6:]])
             data.qvel[:] = 0.0
             mujoco.mj_forward(model, data)
-            # v_mujoco = T q' with T = blockdiag(I, E, I): M_ours = Tᵀ M T, g_ours = −Tᵀ bias.
+            # v_mujoco = T q' with T = blockdiag(I, E, I).
             t = np.eye(24)
             t[3:6, 3:6] = rates_to_body(pitch, roll)
-            m = np.zeros((24, 24))
-            mujoco.mj_fullM(model, data, m)
-            feet = np.array([data.site(f"foot{leg}").xpos for leg in range(6)])
-            for key, theirs, mine in (
-                ("feet", feet, ours.feet(q)),
-                ("M", t.T @ m @ t, ours.mass_matrix(q)),
-                ("g", -t.T @ data.qfrc_bias, ours.gravity_forces(q)),
-            ):
-                worst[key] = max(worst[key], np.abs(mine - theirs).max() / np.abs(theirs).max())
+            record_errors(model, data, ours, q, t, worst)
     assert max(worst.values()) < 1e-9, worst
 
 
@@ -81,15 +88,7 @@ def test_the_exported_pantograph_robot_is_the_same_in_mujoco():
         mujoco.mj_forward(model, data)
         equality = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
         worst["loops"] = max(worst["loops"], np.abs(data.efc_pos[: data.nefc][equality]).max())
-        m = np.zeros((model.nv, model.nv))
-        mujoco.mj_fullM(model, data, m)
-        feet = np.array([data.site(f"foot{leg}").xpos for leg in range(6)])
-        for key, theirs, mine in (
-            ("feet", feet, ours.feet(q)),
-            ("M", g.T @ m @ g, ours.mass_matrix(q)),
-            ("g", -g.T @ data.qfrc_bias, ours.gravity_forces(q)),
-        ):
-            worst[key] = max(worst[key], np.abs(mine - theirs).max() / np.abs(theirs).max())
+        record_errors(model, data, ours, q, g, worst)
     assert worst["loops"] < 1e-12 and max(worst["feet"], worst["M"], worst["g"]) < 1e-9, worst
 
 

@@ -31,6 +31,7 @@ from hexadyn.view.command import view
 from hexadyn.view.data import FOOT_COLUMNS, Run
 from hexadyn.view.export import frame_indices
 from hexadyn.view.measure import HEADLESS_CHROMIUM_ARGS
+from test_view import wait_for
 
 VIEWPORT = {"width": 1280, "height": 800}
 #: The PhantomX's joints (robots/phantomx/phantomx.toml, joints.names).
@@ -247,15 +248,6 @@ def link_mask(image: np.ndarray) -> np.ndarray:
     shading); the ground, the body plate, the paths, the feet and the GUI have none."""
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
     return (r - b > 0.25) & (g > 0.3) & (r > 0.5)
-
-
-def wait_for(predicate, timeout: float = 20.0, what: str = "condition") -> None:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if predicate():
-            return
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 def state(page) -> dict:
