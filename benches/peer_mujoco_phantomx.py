@@ -11,7 +11,8 @@ inertias and foot spheres) on a plane, with per joint:
   (G the duty-per-radian gain of the compliance slope, times the supply), kv = (n k_t)^2 / R
   (the back-EMF), force-limited to the stall torque n k_t L V / R;
 - the rotor as armature J_r n^2 and the dry friction as frictionloss,
-and replays hexadyn's joint references (the goals sent to the servos) held over each 10 ms
+and replays hexadyn's servo goals (the joint references plus the master's friction
+feed-forward, columns ``<joint>_goal[i]``) held over each 10 ms
 control period at dt = 1 ms, implicitfast. Both are timed in the same run, in `--repeats`
 interleaved pairs; the medians are printed with each one's distance walked.
 
@@ -113,7 +114,8 @@ def main() -> None:
     if args.xml:
         args.xml.write_text(xml)
     model = mujoco.MjModel.from_xml_string(xml)
-    ctrl = np.stack([c[f"{j}_ref[{leg}]"] for leg in range(6) for j in JOINTS], axis=1)
+    # The goals the servos received: the references plus the master's friction feed-forward.
+    ctrl = np.stack([c[f"{j}_goal[{leg}]"] for leg in range(6) for j in JOINTS], axis=1)
     x, mj_wall, mj_cpu = mujoco_walk(model, c, ctrl)
     pairs = [(hx_wall, hx_cpu, mj_wall, mj_cpu)]
     for _ in range(args.repeats - 1):

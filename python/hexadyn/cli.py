@@ -309,24 +309,29 @@ def scenarios() -> None:
 @cli.command()
 @click.argument("scenario", required=False, default=None)
 @click.option("-o", "--out", type=click.Path(path_type=Path), required=True, help="Campaign folder (created, or resumed if it holds the same campaign).")
+@click.option("--robot", type=click.Choice(["amru5", "phantomx"]), default=None, help="Without SCENARIO: the shipped robot whose campaign walk to run (amru5: validation_tripod_1_5cm, phantomx: phantomx_montecarlo) [default: amru5].")
 @click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
-@click.option("--variants", default=None, help="Comma-separated friction variants (default: dry_viscous,dry_viscous_load).")
+@click.option("--variants", default=None, help="Comma-separated friction variants (default: every variant of the robot: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
 @click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
 @click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, workers, ray_address, no_progress) -> None:
+def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, workers, ray_address, no_progress) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
-    Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm) for every friction
-    variant, velocity and run, with friction drawn per run from the Gaussians of Table 6.7
-    (truncated at 3 sigma, physical signs). Rerunning the same command resumes an interrupted
-    campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf to --out.
+    Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm, or with --robot
+    phantomx the PhantomX's phantomx_montecarlo) for every friction variant, velocity and run,
+    with friction drawn per run from the Gaussians of the robot's [monte_carlo] table (AMRU5:
+    Table 6.7), truncated at 3 sigma, physical signs. Rerunning the same command resumes an
+    interrupted campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf
+    to --out.
     """
-    from hexadyn.montecarlo import DEFAULT_SCENARIO as CAMPAIGN_SCENARIO
-    from hexadyn.montecarlo import Campaign
+    from hexadyn.montecarlo import DEFAULT_SCENARIOS, Campaign
+
+    if scenario is not None and robot is not None:
+        raise click.BadParameter(f"--robot {robot} with the scenario {scenario}: the scenario names its robot; give one of them", param_hint="--robot")
 
     def listed(option: str, text: str | None, convert):
         if text is None:
@@ -337,7 +342,7 @@ def montecarlo(scenario, out, runs, velocities, variants, seed, friction_stats, 
             raise click.BadParameter(f"{text!r}: {exc}", param_hint=option) from exc
 
     campaign = Campaign.create(
-        scenario or CAMPAIGN_SCENARIO,
+        scenario or DEFAULT_SCENARIOS[robot or "amru5"],
         velocities=None if velocities is None else list(velocities),
         runs_per_velocity=runs,
         variants=listed("--variants", variants, str.strip),
@@ -381,6 +386,17 @@ def export_urdf_command(robot: str, out_file: Path, overwrite: bool) -> None:
     from hexadyn.urdf import export_urdf
 
     click.echo(f"URDF: {export_urdf(robot, out_file, overwrite)}")
+
+
+@cli.command("export-mjcf")
+@click.argument("robot")
+@click.argument("out_file", type=click.Path(path_type=Path))
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+def export_mjcf_command(robot: str, out_file: Path, overwrite: bool) -> None:
+    """Write a robot (shipped name or description file, either leg mechanism) as MuJoCo MJCF."""
+    from hexadyn.urdf import export_mjcf
+
+    click.echo(f"MJCF: {export_mjcf(robot, out_file, overwrite)}")
 
 
 @cli.command("urdf")

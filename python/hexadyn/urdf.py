@@ -16,7 +16,7 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["export_urdf", "import_urdf", "inspect", "standing_height", "write_mjcf"]
+__all__ = ["export_mjcf", "export_urdf", "import_urdf", "inspect", "standing_height", "write_mjcf"]
 
 
 def standing_height(robot) -> float:
@@ -120,6 +120,25 @@ def import_urdf(
     return target
 
 
+def _robot_text(robot: str | os.PathLike, out: str | os.PathLike, overwrite: bool) -> tuple[str, str, Path]:
+    """(description text, its name for errors, the output path) of an export: a shipped robot
+    name or a description file; ValueError (one line) for an unreadable file or an existing
+    `out` without `overwrite`."""
+    from hexadyn._core import shipped_robot_text
+
+    target = Path(out)
+    if target.exists() and not overwrite:
+        raise ValueError(f"{target}: exists; allowed: a new file, or --overwrite")
+    name = os.fspath(robot)
+    try:
+        return shipped_robot_text(name), name, target
+    except ValueError:
+        try:
+            return Path(robot).read_text(encoding="utf-8"), name, target
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{name}: cannot read the robot description: {exc}") from None
+
+
 def export_urdf(robot: str | os.PathLike, out: str | os.PathLike, overwrite: bool = False) -> Path:
     """Writes a serial robot (a shipped name such as ``"phantomx"`` or a description file) as
     URDF to `out`, atomically, and returns `out`: ``base_link``, a link per joint with its
@@ -128,20 +147,24 @@ def export_urdf(robot: str | os.PathLike, out: str | os.PathLike, overwrite: boo
     as the same mechanism). ValueError (one line) for a pantograph robot, an unreadable file or
     an existing `out` without `overwrite`."""
     from hexadyn import atomic
-    from hexadyn._core import robot_urdf, shipped_robot_text
+    from hexadyn._core import robot_urdf
 
-    target = Path(out)
-    if target.exists() and not overwrite:
-        raise ValueError(f"{target}: exists; allowed: a new file, or --overwrite")
-    name = os.fspath(robot)
-    try:
-        text, origin = shipped_robot_text(name), name
-    except ValueError:
-        origin = name
-        try:
-            text = Path(robot).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{origin}: cannot read the robot description: {exc}") from None
+    text, origin, target = _robot_text(robot, out, overwrite)
     urdf = robot_urdf(text, origin)
     atomic.write_file(target, lambda tmp: tmp.write_text(urdf, encoding="utf-8"))
+    return target
+
+
+def export_mjcf(robot: str | os.PathLike, out: str | os.PathLike, overwrite: bool = False) -> Path:
+    """Writes a robot of either leg mechanism (a shipped name or a description file) as MuJoCo
+    MJCF to `out`, atomically, and returns `out`: a serial robot's links, or a pantograph
+    robot's 49 bodies with the linkage loops as ``connect`` equality constraints and the rotors
+    coupled to their joints (``description::mjcf``). ValueError (one line) for an invalid or
+    unreadable description or an existing `out` without `overwrite`."""
+    from hexadyn import atomic
+    from hexadyn._core import robot_mjcf
+
+    text, origin, target = _robot_text(robot, out, overwrite)
+    mjcf = robot_mjcf(text, origin)
+    atomic.write_file(target, lambda tmp: tmp.write_text(mjcf, encoding="utf-8"))
     return target

@@ -104,16 +104,19 @@ def test_names_that_would_make_two_columns_one_are_refused(tmp_path, names, prob
     assert "\n" not in message and str(robot) in message and "joints.names" in message and problem in message, message
 
 
-def test_monte_carlo_stores_the_split_per_joint_in_the_robots_order(tmp_path):
+def test_monte_carlo_stores_the_split_per_joint_under_the_robots_names(tmp_path):
     from hexadyn.montecarlo.execution import simulate_run
-    from hexadyn.montecarlo.storage import PER_JOINT_COLUMNS
+    from hexadyn.montecarlo.storage import per_joint_columns
 
     scenario = shortened("validation_tripod_1_5cm", tmp_path, 2.0)
     amru5 = simulate_run(str(scenario), {})
     renamed = simulate_run(str(scenario), {"scenario.robot": str(renamed_robot(tmp_path))})
     assert amru5["status"] == renamed["status"] == "ok", (amru5, renamed)
-    assert renamed["summary"] == amru5["summary"] | {"wall_time_s": renamed["summary"]["wall_time_s"]}
-    split = [renamed["summary"][c] for c in PER_JOINT_COLUMNS]
+    # The same run; the per-joint columns carry each robot's own names, in its joint order.
+    assert [k for k in amru5["summary"] if k.startswith("energy_electrical_") and k != "energy_electrical_j"] == list(per_joint_columns(AMRU5))
+    assert [k for k in renamed["summary"] if k.startswith("energy_electrical_") and k != "energy_electrical_j"] == list(per_joint_columns(RENAMED))
+    assert list(renamed["summary"].values())[:-1] == list(amru5["summary"].values())[:-1]  # all but the wall time
+    split = [renamed["summary"][c] for c in per_joint_columns(RENAMED)]
     assert sum(split) == pytest.approx(renamed["summary"]["energy_electrical_j"], rel=1e-12)
     assert min(split) > 0.0, split
 

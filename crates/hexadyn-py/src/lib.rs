@@ -6,6 +6,7 @@ mod leg;
 mod link;
 mod mbs;
 mod monte_carlo;
+mod pantograph;
 mod scenario;
 mod schema;
 mod urdf;
@@ -19,6 +20,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SHIPPED_ROBOTS", hexadyn::description::SHIPPED_ROBOTS.map(|(name, _, _)| name).to_vec())?;
     m.add_class::<mbs::PyMultibody>()?;
     m.add_class::<urdf::PyUrdfHexapod>()?;
+    m.add_class::<pantograph::PyPantographHexapod>()?;
+    m.add_function(wrap_pyfunction!(pantograph::robot_mjcf, m)?)?;
     m.add_function(wrap_pyfunction!(urdf::shipped_robot_text, m)?)?;
     m.add_function(wrap_pyfunction!(urdf::robot_urdf, m)?)?;
     m.add_function(wrap_pyfunction!(scenario::run_scenario, m)?)?;

@@ -94,6 +94,12 @@ impl PyMultibody {
         self.data.clear_forces();
         Ok(())
     }
+
+    /// The world positions at q of the `points` (a body and a point in its frame), one row each.
+    pub(crate) fn points_at(&mut self, q: &[f64], points: &[(BodyId, Vector3<f64>)]) -> PyResult<Vec<Vec<f64>>> {
+        self.evaluate(q, &vec![0.0; q.len()])?;
+        Ok(points.iter().map(|(b, local)| self.data.point(*b, local).iter().copied().collect()).collect())
+    }
 }
 
 #[pymethods]

@@ -72,7 +72,7 @@ pub fn specific_resistance(energy_j: f64, mass_kg: f64, distance_m: f64) -> f64 
 }
 
 /// The pantograph description of a robot description text, for the tools written for AMRU5's
-/// legs (`what`, e.g. "the 3D viewer"): ValueError (one line) for an invalid description or a
+/// legs (`what`, e.g. "friction identification"): ValueError (one line) for an invalid description or a
 /// serial one.
 pub fn pantograph_description(text: &str, origin: &str, what: &str) -> PyResult<hexadyn::description::RobotDescription> {
     match Robot::from_str(text, origin).map_err(|e| PyValueError::new_err(e.to_string()))? {

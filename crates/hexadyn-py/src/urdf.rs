@@ -159,9 +159,7 @@ impl PyUrdfHexapod {
     /// The centre of each foot sphere in the world frame at q, a (6, 3) array (m).
     fn feet<'py>(mut self_: PyRefMut<'py, Self>, q: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let feet = self_.feet;
-        let base = self_.as_super();
-        base.evaluate(q.as_slice()?, &[0.0; DOF])?;
-        let rows: Vec<Vec<f64>> = feet.iter().map(|(b, local)| base.data().point(*b, local).iter().copied().collect()).collect();
+        let rows = self_.as_super().points_at(q.as_slice()?, &feet)?;
         Ok(PyArray2::from_vec2(self_.py(), &rows)?)
     }
 

@@ -6,7 +6,7 @@ use hexadyn::description::urdf::serial_hexapod_from_file;
 use hexadyn::description::{Robot, SerialRobot, PHANTOMX_TOML};
 use hexadyn::hexapod::SerialHexapod;
 use hexadyn::physics::terrain::generate::PHANTOMX_ROUGH;
-use hexadyn::scenario::{run_scenario, HeadingSpec, Scenario, Summary, SummaryValue};
+use hexadyn::scenario::{run_scenario, HeadingSpec, Override, Scenario, Summary, SummaryValue};
 
 fn phantomx() -> SerialRobot {
     match Robot::from_str(PHANTOMX_TOML, "phantomx.toml").unwrap() {
@@ -50,6 +50,8 @@ fn the_description_is_its_urdf_and_round_trips() {
     };
     assert!(difference(&again.hexapod, &robot.hexapod) < 1e-12);
     assert_eq!((again.drives, again.joints, again.period, again.supply_voltage, again.ground), (robot.drives.clone(), robot.joints.clone(), robot.period, robot.supply_voltage, robot.ground.clone()));
+    assert!(robot.monte_carlo.is_some());
+    assert_eq!(again.monte_carlo, robot.monte_carlo);
     let names = ["coxa", "femur", "tibia"].map(String::from);
     assert!(robot.to_toml().starts_with(&mechanism_toml(&robot.hexapod, &names)));
     assert!((robot.total_mass_kg() - 1.8428).abs() < 1e-9, "{}", robot.total_mass_kg());
@@ -78,6 +80,11 @@ fn a_broken_serial_description_names_its_field() {
         ("mass_kg = 0.0696", "mass_kg = -0.0696", "legs[0].joints[0].link.mass_kg"),
         ("upper = 1.413717", "upper = -2.0", "legs[0].joints[0].upper"),
         ("punch = 0.031280547", "punch = 2.0", "drives.coxa.servo.punch"),
+        ("[monte_carlo.friction.tibia]", "[monte_carlo.friction.knee]", "monte_carlo.friction.knee"),
+        ("tau_f_d = { mu = 0.590, sigma = 0.248 }", "tau_f_d = { mu = 0.590, sigma = -0.248 }", "monte_carlo.friction.coxa.tau_f_d"),
+        ("tau_f_d = { mu = 0.590, sigma = 0.248 }", "tau_f_d_plus = { mu = 0.590, sigma = 0.248 }", "monte_carlo.friction.coxa.tau_f_d_plus"),
+        ("runs_per_velocity = 1000", "runs_per_velocity = 0", "monte_carlo.runs_per_velocity"),
+        ("velocities_m_per_s = [0.02, 0.03, 0.04, 0.05]", "velocities_m_per_s = []", "monte_carlo.velocities_m_per_s"),
     ];
     for (from, to, field) in cases {
         assert!(PHANTOMX_TOML.contains(from), "{from}");
@@ -98,20 +105,25 @@ fn number(s: &Summary, key: &str) -> f64 {
 }
 
 /// The shipped walks of the issue: 0 clamped IK references, the energy account closed within
-/// 0.1 % of the electrical energy, and the body where the gait took it.
+/// 0.1 % of the electrical energy, the body where the gait took it (within 3 %: the feet slip
+/// and the servos lag at the stops) and, with a navigation system, on its path within 3 mm.
 #[test]
 fn the_shipped_walks_walk() {
-    for (name, advance) in [("phantomx_tripod", 0.7), ("phantomx_wave", 0.7), ("phantomx_spline", 0.97)] {
+    for name in ["phantomx_tripod", "phantomx_wave", "phantomx_spline"] {
         let s = Scenario::from_file(root().join(format!("python/hexadyn/scenarios/{name}.toml"))).unwrap();
         let r = run_scenario(&s, |_| {}).unwrap();
         let summary = &r.summary;
         let (walked, reference) = (number(summary, "distance_walked_m"), number(summary, "reference_distance_m"));
         let balance = number(summary, "energy_balance_error_relative");
         let clamped = number(summary, "clamped_ik_references");
-        println!("{name}: walked {walked:.4} m of {reference:.4} m, balance {balance:.2e}, clamped {clamped}, path error {:.4} m", number(summary, "tracking_error_xy_max_m"));
+        let path = number(summary, "tracking_error_xy_max_m");
+        println!("{name}: walked {walked:.4} m of {reference:.4} m, balance {balance:.2e}, clamped {clamped}, path error {path:.4} m");
         assert_eq!(clamped, 0.0, "{name}");
         assert!(balance.abs() < 1e-3, "{name}: energy balance {balance}");
-        assert!(walked > advance * reference, "{name}: {walked} m of {reference} m");
+        assert!((walked / reference - 1.0).abs() < 0.03, "{name}: {walked} m of {reference} m");
+        if s.gait.as_ref().is_some_and(|g| g.navigation) {
+            assert!(path < 3e-3, "{name}: path error {path} m");
+        }
     }
 }
 
@@ -120,7 +132,7 @@ fn the_shipped_walks_walk() {
 /// force). It walks the commanded distance, its legs keep stepping, the body keeps its height
 /// and attitude over the ground, the feet meet the relief, no foot reference is clamped and the
 /// energy account closes. (With the thesis' 10 N landing threshold, 55 % of this robot's
-/// weight, the same run clamps 42 202 references and its body halts after 0.22 m: measured.)
+/// weight, the same run clamps 41 823 references and its body halts after 0.10 m: measured.)
 #[test]
 fn the_free_gait_walks_over_rough_ground() {
     let s = Scenario::from_file(root().join("python/hexadyn/scenarios/phantomx_free_gait_rough.toml")).unwrap();
@@ -187,4 +199,72 @@ fn the_free_gait_walks_over_rough_ground() {
     assert!(clearance.0 > height - 2.0 * rms && clearance.1 < height + 2.0 * rms, "clearance {clearance:?} for {height} m");
     let tilt_max = (4.0 * rms / 0.4f64).atan();
     assert!(tilt.iter().all(|&a| a < tilt_max), "roll and pitch {tilt:?} rad (at most {tilt_max})");
+}
+
+/// The friction feed-forward of the master takes out the lag a servo's dry friction leaves:
+/// without it the AX-12A's 0.59 N m gear friction, which its compliance law balances only
+/// 3.2 degrees from the goal, holds each joint until the goal has moved that far, and the
+/// tripod walks a fifth less than commanded.
+#[test]
+fn the_friction_feedforward_takes_out_the_servo_lag() {
+    let text = std::fs::read_to_string(root().join("python/hexadyn/scenarios/phantomx_tripod.toml")).unwrap();
+    assert!(text.contains("friction_feedforward = true"));
+    let walked = |text: &str| {
+        let s = Scenario::from_str(text, "phantomx_tripod.toml", &root().join("python/hexadyn/scenarios")).unwrap();
+        let r = run_scenario(&s, |_| {}).unwrap();
+        number(&r.summary, "distance_walked_m") / number(&r.summary, "reference_distance_m")
+    };
+    let (with, without) = (walked(&text), walked(&text.replace("friction_feedforward = true", "friction_feedforward = false")));
+    println!("tripod with the feed-forward {with:.4}, without {without:.4} of the commanded distance");
+    assert!(with > 0.97 && without < 0.9, "with {with}, without {without}");
+}
+
+fn tripod_with(overrides: &[Override]) -> Result<Scenario, hexadyn::scenario::ScenarioError> {
+    Scenario::from_file_with(root().join("python/hexadyn/scenarios/phantomx_tripod.toml"), overrides)
+}
+
+fn serial(s: &Scenario) -> &SerialRobot {
+    match &s.robot {
+        Robot::Serial(r) => r,
+        Robot::Pantograph(_) => panic!("a serial robot"),
+    }
+}
+
+/// `[model.joint_friction.<joint>]` on serial legs, keyed by the robot's joint names: the
+/// fields set replace the drive's friction of that joint (every leg's), the others are kept.
+#[test]
+fn joint_friction_overrides_the_drive_friction_of_a_serial_joint() {
+    let plain = tripod_with(&[]).unwrap();
+    let s = tripod_with(&[Override::new("model.joint_friction.femur.tau_f_d", 1.18), Override::new("model.joint_friction.tibia.f_v", 0.01), Override::new("model.joint_friction.coxa.sigma_0", 1000)]).unwrap();
+    let (a, b) = (serial(&plain), serial(&s));
+    assert_eq!(b.drives[1].friction.tau_f_d, 1.18);
+    assert_eq!(b.drives[2].friction.f_v, 0.01);
+    assert_eq!(b.drives[0].friction.sigma_0, 1000.0);
+    assert_eq!((b.drives[0].friction.tau_f_d, b.drives[2].friction.tau_f_d, b.drives[1].friction.f_v), (a.drives[0].friction.tau_f_d, a.drives[2].friction.tau_f_d, a.drives[1].friction.f_v));
+    assert_eq!(b.drives[1].friction.linear_zone, a.drives[1].friction.linear_zone);
+    // The master's friction feed-forward is the robot's as described, not the override's.
+    assert_eq!(s.gait.as_ref().unwrap().friction_feedforward, plain.gait.as_ref().unwrap().friction_feedforward);
+    assert!(plain.gait.as_ref().unwrap().friction_feedforward.is_some());
+    // The effective text reads back the same.
+    let again = Scenario::from_str(&s.text, "effective.toml", &root().join("python/hexadyn/scenarios")).unwrap();
+    assert_eq!(serial(&again).drives, b.drives);
+}
+
+#[test]
+fn joint_friction_errors_on_serial_legs_are_one_line() {
+    let cases: [(Override, &str, &str); 6] = [
+        (Override::new("model.joint_friction.knee.tau_f_d", 1.0), "model.joint_friction.knee", "[model.joint_friction.coxa], [model.joint_friction.femur], [model.joint_friction.tibia]"),
+        (Override::new("model.joint_friction.q_r.tau_f_d_plus", 1.0), "model.joint_friction.q_r", "[model.joint_friction.coxa]"),
+        (Override::new("model.joint_friction.femur.tau_f_d_plus", 1.0), "model.joint_friction.femur.tau_f_d_plus", "one of tau_f_d, f_v, sigma_0, sigma_1, v_d"),
+        (Override::new("model.joint_friction.femur.tau_f_d", -0.5), "model.joint_friction.femur.tau_f_d", ">= 0"),
+        (Override::new("model.joint_friction.tibia.v_d", 0.0), "model.joint_friction.tibia.v_d", "> 0"),
+        (Override::new("model.joint_friction.coxa.f_v", "much"), "model.joint_friction.coxa.f_v", "not a number"),
+    ];
+    for (o, field, allowed) in cases {
+        let message = tripod_with(std::slice::from_ref(&o)).expect_err(&o.field).to_string();
+        assert!(!message.contains('\n'), "{message}");
+        assert!(message.contains("phantomx_tripod.toml") && message.contains(&format!("field `{field}`")) && message.contains(allowed), "{message}");
+    }
+    let message = tripod_with(&[Override::new("model.load_dependence", true)]).unwrap_err().to_string();
+    assert!(message.contains("no load dependence on serial legs"), "{message}");
 }

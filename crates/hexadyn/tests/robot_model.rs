@@ -273,6 +273,7 @@ fn input_change_is_the_difference_of_two_residuals() {
             let command = |rng: &mut ChaCha8Rng| Command {
                 voltages: std::array::from_fn(|_| rng.random_range(-2.0..2.0) * supply),
                 references: std::array::from_fn(|k| q[6 + k] + rng.random_range(-0.01..0.01)),
+                goals: None,
             };
             let (first, second) = (command(&mut rng), command(&mut rng));
             r.command(&first, &q);

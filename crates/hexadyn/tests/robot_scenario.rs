@@ -494,6 +494,9 @@ fn gait_errors_name_the_field() {
     assert!(s.contains("0.3") && s.contains("a clearance in (0, 0.12"), "{s}");
     let s = field_error(&with(v, "clearance_m = 0.105", "clearance_m = 0.105\nbody_height_m = 0.6"), "gait.body_height_m");
     assert!(s.contains("0.6") && s.contains("(0.2939, 0.5040)"), "{s}");
+    // AMRU5's joints are PI loops: no servo goals to lead.
+    let s = field_error(&with(v, "clearance_m = 0.105", "clearance_m = 0.105\nfriction_feedforward = true"), "gait.friction_feedforward");
+    assert!(s.contains("PI loops") && s.contains("position servos"), "{s}");
 
     // The stroke must fit the workspace: 5 cm/s x 8.4 s = 0.42 m > 2 x 0.148 m.
     let s = field_error(&with(v, "vx_m_s = 0.015", "vx_m_s = 0.05"), "gait.heading");

@@ -13,6 +13,11 @@ The two friction variants of Section 6.5 share the draws (common random numbers)
 
 The defaults (velocities, runs per velocity) come from the ``[monte_carlo]`` table of the
 scenario's robot description: 1000 runs at 1, 1.5, 2 and 2.5 cm/s for the AMRU5.
+
+A robot with serial legs (the PhantomX: ``phantomx_montecarlo``, the default scenario of
+``robot="phantomx"``) draws its drives' friction from the Gaussians of its ``[monte_carlo]``
+table, written to ``[model.joint_friction.<joint>]`` under its own joint names; it has no load
+influence, so only the ``dry_viscous`` variant.
 """
 
 from __future__ import annotations
@@ -31,10 +36,13 @@ from hexadyn.montecarlo.storage import CampaignStore, RunKey
 from hexadyn.montecarlo.tables import plot_specific_resistance, specific_resistance_table, write_table
 from hexadyn.runner import resolve_scenario
 
-__all__ = ["DEFAULT_SCENARIO", "VARIANTS", "Campaign", "run_campaign"]
+__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "VARIANTS", "Campaign", "run_campaign", "variants_of"]
 
 #: Scenario of a campaign without an explicit one: the Table 6.2 validation walk.
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
+
+#: The campaign scenario of each shipped robot (``hexadyn montecarlo --robot NAME``).
+DEFAULT_SCENARIOS = {"amru5": DEFAULT_SCENARIO, "phantomx": "phantomx_montecarlo"}
 
 #: Friction variants of Section 6.5 -> whether the load influence of Eq. 5.12 is on.
 VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
@@ -42,6 +50,12 @@ VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
 #: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
 #: (False) or a callable ``progress(finished_runs, total_runs)`` called after each stored run.
 Progress = Union[bool, Callable[[int, int], object]]
+
+
+def variants_of(distributions: FrictionDistributions) -> tuple[str, ...]:
+    """The variants a robot's set-up allows: the load influence needs drawn load coefficients
+    (AMRU5's horizontal joints, Eq. 5.12); a serial robot has ``dry_viscous`` only."""
+    return tuple(v for v, load in VARIANTS.items() if not load or distributions.load_parameters)
 
 
 @dataclass(frozen=True)
@@ -89,10 +103,12 @@ class Campaign:
         velocities = tuple(float(v) for v in (distributions.velocities_m_per_s if velocities is None else velocities))
         if not velocities or not all(math.isfinite(v) and v > 0 for v in velocities):
             raise ValueError(f"velocities = {list(velocities)}: need one or more finite velocities > 0 (m/s)")
-        variants = tuple(VARIANTS if variants is None else variants)
-        unknown = [v for v in variants if v not in VARIANTS]
+        allowed = variants_of(distributions)
+        variants = tuple(allowed if variants is None else variants)
+        unknown = [v for v in variants if v not in allowed]
         if unknown or not variants or len(set(variants)) != len(variants):
-            raise ValueError(f"variants = {list(variants)}: need distinct variants among {', '.join(VARIANTS)}")
+            why = "" if len(allowed) == len(VARIANTS) else f" (no load influence on the legs of {distributions.robot})"
+            raise ValueError(f"variants = {list(variants)}: need distinct variants among {', '.join(allowed)}{why}")
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise ValueError(f"seed = {seed!r}: need an integer >= 0")
         campaign = cls(path, info["name"], path.read_text(), velocities, runs, variants, seed, distributions)
@@ -156,7 +172,7 @@ class Campaign:
         """
         executor: Executor = Ray(ray, workers) if ray else ProcessPool(workers)
         keys = self.keys()
-        with CampaignStore.open(out, self.configuration()) as store:
+        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
             finished = store.finished()
             pending = [k for k in keys if k not in finished]
             if pending:

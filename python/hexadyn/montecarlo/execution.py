@@ -3,7 +3,7 @@
 Both executors take (key, overrides) tasks and yield (key, outcome) as the simulations finish,
 in any order; the caller (the parent process, or the Ray driver) stores the outcomes. An
 outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
-:data:`~hexadyn.montecarlo.storage.SUMMARY_COLUMNS`) or ``{"status": "failed", "error":
+:func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints) or ``{"status": "failed", "error":
 message}`` for a simulation the engine rejected (ValueError); any other exception stops the
 campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the tasks not
 finished yet and stops the workers.
@@ -19,7 +19,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, Iterable, Iterator, Mapping, Protocol
 
-from hexadyn.montecarlo.storage import PER_JOINT_COLUMNS, SUMMARY_COLUMNS, RunKey
+from hexadyn.montecarlo.storage import RunKey, summary_columns
 
 __all__ = ["Executor", "ProcessPool", "Ray", "simulate_run"]
 
@@ -35,8 +35,9 @@ WALKS_PER_TASK = 4
 
 
 def simulate_run(scenario: str, overrides: Mapping[str, Any]) -> dict[str, Any]:
-    """Runs one simulation (summary only) and returns its outcome; the per-joint entries of the
-    robot's joints go to the :data:`~hexadyn.montecarlo.storage.PER_JOINT_COLUMNS` in order."""
+    """Runs one simulation (summary only) and returns its outcome: the
+    :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints (the split of E
+    per joint under the robot's joint names)."""
     from hexadyn import _core
     from hexadyn.vocabulary import Joints
 
@@ -44,10 +45,9 @@ def simulate_run(scenario: str, overrides: Mapping[str, Any]) -> dict[str, Any]:
         raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
     except ValueError as exc:
         return {"status": "failed", "error": " ".join(str(exc).split())}
-    summary = dict(raw["summary"])
+    summary = raw["summary"]
     names = Joints.of_robot(raw["robot"]).names
-    summary.update(zip(PER_JOINT_COLUMNS, (summary[f"energy_electrical_{name}_j"] for name in names)))
-    return {"status": "ok", "summary": {c: summary[c] for c in SUMMARY_COLUMNS}}
+    return {"status": "ok", "summary": {c: summary[c] for c in summary_columns(names)}}
 
 
 def _several(run_one):

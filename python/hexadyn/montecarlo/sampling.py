@@ -40,6 +40,8 @@ class FrictionDistributions:
             (Eq. 5.12 coefficients of q_h).
         fixed: scenario field -> value of the parameters set but not drawn (the horizontal
             viscous slopes, neglected in Section 6.5).
+        joints: the names of a leg's joints (AMRU5's ``q_r``, ``q_v``, ``q_h``; a serial
+            robot's own, which key its fields: ``model.joint_friction.femur.tau_f_d``).
     """
 
     robot: str
@@ -50,10 +52,12 @@ class FrictionDistributions:
     physical_bounds: dict[str, tuple[float, float]]
     load_parameters: tuple[str, ...]
     fixed: dict[str, float]
+    joints: tuple[str, ...] = ("q_r", "q_v", "q_h")
 
     @classmethod
     def of_robot(cls, robot: str = "amru5") -> FrictionDistributions:
-        """Reads the distributions of a robot description (``"amru5"`` or a file path)."""
+        """Reads the distributions of a robot description (a shipped robot, ``"amru5"`` or
+        ``"phantomx"``, or a file path; a serial one needs its ``[monte_carlo]`` table)."""
         from hexadyn import _core
 
         d = _core.monte_carlo_distributions(robot)
@@ -66,6 +70,7 @@ class FrictionDistributions:
             physical_bounds={k: (float(lo), float(hi)) for k, (lo, hi) in d["physical_bounds"].items()},
             load_parameters=tuple(d["load_parameters"]),
             fixed={k: float(v) for k, v in d["fixed"].items()},
+            joints=tuple(d["joints"]),
         )
 
     def with_stats(self, stats: dict[str, tuple[float, float]], source: str) -> FrictionDistributions:

@@ -18,40 +18,55 @@ import json
 import os
 import sqlite3
 from pathlib import Path
-from typing import Any, Mapping, NamedTuple
+from typing import Any, Mapping, NamedTuple, Sequence
 
 from hexadyn import atomic
 
-__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey"]
+__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey", "per_joint_columns", "summary_columns"]
 
 CAMPAIGN_FILE = "campaign.json"
 DATABASE_FILE = "runs.sqlite"
 #: Identifies a hexadyn Monte Carlo folder in campaign.json.
 FORMAT = "hexadyn-montecarlo"
 
-#: The database columns of the split of E per joint of a leg, in the robot's joint order: the
-#: summary entries ``energy_electrical_{name}_j`` of the robot's joints, stored under AMRU5's
-#: names (the campaign format is the same for every robot).
-PER_JOINT_COLUMNS = ("energy_electrical_q_r_j", "energy_electrical_q_v_j", "energy_electrical_q_h_j")
+#: The joints of AMRU5's legs, whose names the per-joint columns of its campaigns carry.
+AMRU5_JOINTS = ("q_r", "q_v", "q_h")
 
-#: Summary entries of a run kept in the database (``_core.run_scenario(...)["summary"]``):
-#: ξ (Eq. 6.6), E and its split per joint (:data:`PER_JOINT_COLUMNS`), distance, mass, averaged
-#: power, Joule and friction losses, the energy balance error, the simulated and the wall time.
-SUMMARY_COLUMNS = (
-    "specific_resistance",
-    "energy_electrical_j",
-    *PER_JOINT_COLUMNS,
-    "energy_joule_j",
-    "energy_friction_j",
-    "energy_balance_error_relative",
-    "robot_mass_kg",
-    "distance_walked_m",
-    "average_power_w",
-    "duration_s",
-    "wall_time_s",
-)
 
-_SCHEMA = f"""
+def per_joint_columns(joints: Sequence[str] = AMRU5_JOINTS) -> tuple[str, ...]:
+    """The database columns of the split of E per joint of a leg, in the robot's joint order:
+    the summary entries ``energy_electrical_{name}_j`` of the robot's joints (AMRU5's
+    ``energy_electrical_q_r_j``..., the PhantomX's ``energy_electrical_coxa_j``...)."""
+    return tuple(f"energy_electrical_{name}_j" for name in joints)
+
+
+def summary_columns(joints: Sequence[str] = AMRU5_JOINTS) -> tuple[str, ...]:
+    """Summary entries of a run kept in the database (``_core.run_scenario(...)["summary"]``):
+    ξ (Eq. 6.6), E and its split per joint (:func:`per_joint_columns`), distance, mass,
+    averaged power, Joule and friction losses, the energy balance error, the simulated and the
+    wall time."""
+    return (
+        "specific_resistance",
+        "energy_electrical_j",
+        *per_joint_columns(joints),
+        "energy_joule_j",
+        "energy_friction_j",
+        "energy_balance_error_relative",
+        "robot_mass_kg",
+        "distance_walked_m",
+        "average_power_w",
+        "duration_s",
+        "wall_time_s",
+    )
+
+
+#: AMRU5's per-joint columns and summary columns.
+PER_JOINT_COLUMNS = per_joint_columns()
+SUMMARY_COLUMNS = summary_columns()
+
+
+def _schema(columns: Sequence[str]) -> str:
+    return f"""
 CREATE TABLE IF NOT EXISTS runs (
     variant TEXT NOT NULL,
     velocity_index INTEGER NOT NULL,
@@ -60,7 +75,7 @@ CREATE TABLE IF NOT EXISTS runs (
     status TEXT NOT NULL CHECK (status IN ('ok', 'failed')),
     error TEXT,
     parameters TEXT NOT NULL,
-    {", ".join(f"{c} REAL" for c in SUMMARY_COLUMNS)},
+    {", ".join(f"{c} REAL" for c in columns)},
     PRIMARY KEY (variant, velocity_index, run_index)
 )
 """
@@ -77,13 +92,15 @@ class RunKey(NamedTuple):
 class CampaignStore:
     """A campaign folder, created or reopened with :meth:`open`."""
 
-    def __init__(self, folder: Path, connection: sqlite3.Connection) -> None:
+    def __init__(self, folder: Path, connection: sqlite3.Connection, joints: Sequence[str] = AMRU5_JOINTS) -> None:
         self.folder = folder
         self._db = connection
+        self.columns = summary_columns(joints)
 
     @classmethod
-    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any]) -> CampaignStore:
+    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any], joints: Sequence[str] = AMRU5_JOINTS) -> CampaignStore:
         """Creates the campaign folder, or reopens it if it holds the same configuration.
+        ``joints``: the robot's joint names, for the per-joint columns.
 
         Raises ValueError if ``folder`` holds something else than a campaign, or a campaign
         with another configuration (naming the first differing field).
@@ -100,8 +117,8 @@ class CampaignStore:
             atomic.write_file(config_file, lambda tmp: tmp.write_text(text))
         connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
         with connection:
-            connection.execute(_SCHEMA)
-        return cls(folder, connection)
+            connection.execute(_schema(summary_columns(joints)))
+        return cls(folder, connection, joints)
 
     def close(self) -> None:
         self._db.close()
@@ -124,8 +141,8 @@ class CampaignStore:
         "error": message}``. A run already stored is an error (sqlite3.IntegrityError).
         """
         summary = outcome.get("summary", {})
-        columns = ("variant", "velocity_index", "run_index", "velocity_m_s", "status", "error", "parameters", *SUMMARY_COLUMNS)
-        values = (*key, velocity_m_s, outcome["status"], outcome.get("error"), json.dumps(dict(parameters)), *(summary.get(c) for c in SUMMARY_COLUMNS))
+        columns = ("variant", "velocity_index", "run_index", "velocity_m_s", "status", "error", "parameters", *self.columns)
+        values = (*key, velocity_m_s, outcome["status"], outcome.get("error"), json.dumps(dict(parameters)), *(summary.get(c) for c in self.columns))
         with self._db:
             self._db.execute(f"INSERT INTO runs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})", values)
 

@@ -2,9 +2,10 @@
 
 :class:`Run` reads only the columns the scene needs from ``timeseries.parquet`` (a 1000 s walk is
 10^5 rows of about 300 columns: the plotted signals are read on demand, column by column) and the
-scenario and robot texts from ``metadata.json``. The robot is drawn from the recorded joint
-coordinates through the engine's own multibody kinematics (:class:`hexadyn._core.Kinematics`),
-frame by frame, so the page never holds the whole run.
+scenario and robot texts from ``metadata.json``. The robot, AMRU5's pantograph legs or a serial
+robot's, is drawn from the recorded joint coordinates through the engine's own multibody
+kinematics (:class:`hexadyn._core.Kinematics`), frame by frame, so the page never holds the
+whole run.
 """
 
 from __future__ import annotations
@@ -56,7 +57,8 @@ class Frame:
     #: All bodies: names as in :attr:`Run.body_names`, positions (B, 3), rotations (B, 3, 3).
     positions: np.ndarray
     rotations: np.ndarray
-    #: Per leg the points named by :attr:`Run.leg_point_names` (6, 8, 3); feet = ``[:, -1]``.
+    #: Per leg the points named by :attr:`Run.leg_point_names` (6, P, 3): AMRU5's 8 pantograph
+    #: points, or a serial leg's joint origins and foot; feet = ``[:, -1]``.
     leg_points: np.ndarray
     #: Ground force on each foot (6, 3) and foot phase (6,), -1 where not recorded.
     forces: np.ndarray

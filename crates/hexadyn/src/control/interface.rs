@@ -43,6 +43,9 @@ pub struct Measurements {
 pub struct Command {
     pub voltages: [f64; JOINTS],
     pub references: [f64; JOINTS],
+    /// The goals sent to position servos when they are not the references (a friction
+    /// feed-forward, [`super::FrictionFeedForward`]).
+    pub goals: Option<[f64; JOINTS]>,
 }
 
 /// A controller run at the control period with zero-order-hold outputs.

@@ -17,7 +17,7 @@ pub fn joint_pis(gains: &[PiGains; JOINTS], dt: f64) -> [DigitalPi; JOINTS] {
 /// voltage, Section 4.4.5) tracking `references`: the last stage of every closed-loop controller.
 pub fn pi_command(pis: &mut [DigitalPi; JOINTS], references: [f64; JOINTS], m: &Measurements) -> Command {
     let voltages = std::array::from_fn(|k| pis[k].update(references[k] - m.positions[k], m.supply_voltage));
-    Command { voltages, references }
+    Command { voltages, references, goals: None }
 }
 
 /// Joint references q_d(t).
@@ -127,7 +127,7 @@ impl<R: ReferenceSource> Controller for JointPiController<R> {
             }
             None => self.pis[k].update(references[k] - m.positions[k], m.supply_voltage),
         });
-        Command { voltages, references }
+        Command { voltages, references, goals: None }
     }
 }
 
@@ -137,7 +137,7 @@ pub struct ReferenceFeed<R: ReferenceSource>(pub R);
 
 impl<R: ReferenceSource> Controller for ReferenceFeed<R> {
     fn update(&mut self, m: &Measurements) -> Command {
-        Command { voltages: [0.0; JOINTS], references: self.0.reference(m.t) }
+        Command { voltages: [0.0; JOINTS], references: self.0.reference(m.t), goals: None }
     }
 }
 
@@ -147,7 +147,7 @@ pub struct Unpowered;
 
 impl Controller for Unpowered {
     fn update(&mut self, m: &Measurements) -> Command {
-        Command { voltages: [0.0; JOINTS], references: m.positions }
+        Command { voltages: [0.0; JOINTS], references: m.positions, goals: None }
     }
 }
 

@@ -22,4 +22,4 @@ pub use ground_experiment::{GroundExperiment, GroundExperimentController, Ground
 pub use low_pass::{DigitalLowPass, DIGITAL_CUTOFF_HZ};
 pub use torque_estimation::{TorqueEstimate, TorqueEstimator};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};
-pub use servo::{PositionServo, ServoVoltage};
+pub use servo::{FrictionFeedForward, PositionServo, ServoVoltage};

@@ -16,6 +16,10 @@
 //!
 //! The goal is held within the servo's angle limits (the CW/CCW limits of its control table),
 //! so that a servo never drives beyond them: it has no limit switch.
+//!
+//! The master may add a friction feed-forward to its goals ([`FrictionFeedForward`]).
+
+use crate::hexapod::JOINTS;
 
 /// One position servo's controller.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,10 +78,70 @@ impl PositionServo {
         ServoVoltage { u: e.signum() * d * supply, du_dq: -dd * supply }
     }
 
+    /// The error magnitude |goal − q| at which the law's duty reaches `d` (the inverse of the
+    /// duty over its rising part): the margin for d ≤ 0, the end of the slope for d at or beyond
+    /// the torque limit.
+    pub fn error_for_duty(&self, d: f64) -> f64 {
+        let d = d.clamp(0.0, self.torque_limit);
+        if d < self.punch {
+            self.margin + self.resolution * d / self.punch
+        } else if self.torque_limit > self.punch {
+            self.margin + self.resolution + (d - self.punch) * self.slope / (self.torque_limit - self.punch)
+        } else {
+            self.margin + self.resolution
+        }
+    }
+
     /// The proportional gain of the law's linear part (V/rad), for the master's own use of
     /// the servo (the equivalent of the PI gain K of Table 4.1).
     pub fn gain(&self, supply: f64) -> f64 {
         (self.torque_limit - self.punch) / self.slope * supply
+    }
+}
+
+/// The master's friction feed-forward for position servos (beyond the thesis, whose PI loops
+/// integrate the friction away; model-based friction compensation, B. Armstrong-Hélouvry,
+/// P. Dupont, C. Canudas de Wit, "A survey of models, analysis tools and compensation methods
+/// for the control of machines with friction", Automatica 30(7), 1994). A servo's proportional
+/// law builds an error before its torque overcomes the gear's dry friction τ_f,d: a moving
+/// joint lags its goal by that error e_f, and a joint starting to move waits for it, sticking
+/// and slipping at each change of direction. The master adds e_f to each goal in the direction
+/// the reference moves:
+///
+///   goal = q_d + e_f tanh(q'_d / ε),
+///
+/// with e_f the error at which the stalled motor's torque n k_t u / R (Eq. 4.4-4.6 at q' = 0)
+/// equals τ_f,d ([`PositionServo::error_for_duty`] of u = τ_f,d R / (n k_t) over the supply),
+/// q'_d the reference's rate over the last control period and ε the linear zone of the joint's
+/// dry friction (Eq. 6.1), over which the friction itself changes sides. The first update has
+/// no rate: its goals are the references.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrictionFeedForward {
+    servos: [PositionServo; JOINTS],
+    /// τ_f,d R / (n k_t) of each joint: the voltage whose stall torque is the dry friction (V).
+    friction_voltage: [f64; JOINTS],
+    /// ε of each joint (rad/s or m/s).
+    zone: [f64; JOINTS],
+    /// Control period (s).
+    dt: f64,
+    previous: Option<[f64; JOINTS]>,
+}
+
+impl FrictionFeedForward {
+    /// The feed-forward of the servos `servos` with, per joint, the voltage whose stall torque
+    /// is its dry friction and its linear zone ε, at the control period `dt`.
+    pub fn new(servos: [PositionServo; JOINTS], friction_voltage: [f64; JOINTS], zone: [f64; JOINTS], dt: f64) -> Self {
+        FrictionFeedForward { servos, friction_voltage, zone, dt, previous: None }
+    }
+
+    /// The goals for the joint references `references` with the supply voltage `supply`.
+    pub fn goals(&mut self, references: &[f64; JOINTS], supply: f64) -> [f64; JOINTS] {
+        let previous = self.previous.replace(*references).unwrap_or(*references);
+        std::array::from_fn(|k| {
+            let rate = (references[k] - previous[k]) / self.dt;
+            let e_f = self.servos[k].error_for_duty(self.friction_voltage[k] / supply);
+            references[k] + e_f * (rate / self.zone[k]).tanh()
+        })
     }
 }
 
@@ -132,5 +196,40 @@ mod tests {
         assert_eq!(s.voltage(5.0, 2.0, 12.0).u, 0.0);
         assert!(s.voltage(5.0, 1.9, 12.0).u > 0.0);
         assert!(s.voltage(5.0, 2.1, 12.0).u < 0.0);
+    }
+
+    #[test]
+    fn the_error_for_a_duty_inverts_the_law() {
+        let s = ax12();
+        for k in 1..1000 {
+            let d = k as f64 / 1000.0 * s.torque_limit;
+            let e = s.error_for_duty(d);
+            assert_relative_eq!(s.voltage(e, 0.0, 1.0).u, d, epsilon = 1e-12);
+        }
+        assert_eq!(s.error_for_duty(-0.5), s.margin);
+        assert_eq!(s.error_for_duty(2.0), s.error_for_duty(s.torque_limit));
+    }
+
+    /// Goals moving at a steady rate get the error whose stalled torque is the dry friction,
+    /// ahead in the direction of the motion; still goals get nothing.
+    #[test]
+    fn the_feed_forward_leads_a_moving_goal_by_the_friction_error() {
+        let s = ax12();
+        // AX-12A-like: τ_f,d = 0.59 N m with n k_t / R = 0.174 N m/V: 3.39 V; ε = 1e-3 rad/s.
+        let (u_f, supply, dt) = (0.59 / 0.174, 11.1, 0.01);
+        let mut ff = FrictionFeedForward::new([s; JOINTS], [u_f; JOINTS], [1e-3; JOINTS], dt);
+        let rates: [f64; JOINTS] = std::array::from_fn(|k| 0.1 * (k as f64 - 8.0));
+        let at = |t: f64| -> [f64; JOINTS] { std::array::from_fn(|k| 0.2 + rates[k] * t) };
+        assert_eq!(ff.goals(&at(0.0), supply), at(0.0));
+        let goals = ff.goals(&at(dt), supply);
+        for k in 0..JOINTS {
+            let offset = goals[k] - at(dt)[k];
+            if rates[k] == 0.0 {
+                assert_eq!(offset, 0.0);
+                continue;
+            }
+            // The servo's voltage at that error is the friction's, with the rate's sign.
+            assert_relative_eq!(s.voltage(goals[k], at(dt)[k], supply).u, u_f * rates[k].signum(), epsilon = 1e-9);
+        }
     }
 }

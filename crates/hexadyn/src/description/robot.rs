@@ -7,6 +7,7 @@ use std::path::Path;
 use super::serial::{SerialDescriptionFile, SerialRobot};
 use super::{PiGains, RobotDescription};
 use crate::fields::{Ctx, DescriptionError, Result, SpanIndex};
+use crate::control::FrictionFeedForward;
 use crate::hexapod::{LegJoints, PantographJoint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions, RobotParts};
 
@@ -113,6 +114,15 @@ impl Robot {
         match self {
             Robot::Pantograph(d) => d.joint_pi_gains(),
             Robot::Serial(s) => std::array::from_fn(|k| s.pi_gains(k)),
+        }
+    }
+
+    /// The master's friction feed-forward for position servos at the control period `dt`
+    /// (None without servos).
+    pub fn friction_feedforward(&self, dt: f64) -> Option<FrictionFeedForward> {
+        match self {
+            Robot::Pantograph(_) => None,
+            Robot::Serial(s) => s.friction_feedforward(dt),
         }
     }
 

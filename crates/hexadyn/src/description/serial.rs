@@ -15,14 +15,14 @@ use serde::Deserialize;
 
 use super::tables::GroundTable;
 use super::PiGains;
-use crate::control::{Encoder, PositionServo};
+use crate::control::{Encoder, FrictionFeedForward, PositionServo};
 use crate::fields::{Bound, Ctx, Finite, NonNegative, Positive, Result};
 use crate::hexapod::{JointKind, LegJoints, Link, Rotor, SerialHexapod, SerialJoint, SerialLeg, JOINTS, LEG_COUNT};
 use crate::physics::{DcMotor, DryViscous, FrictionElement, GroundContact, JointFriction, LuGre, SteadyState};
 use crate::robot::model::{FrictionModel, JointControl, ModelOptions, RobotParts};
 use crate::spatial::{yaw_pitch_roll, Htm};
 
-use super::values::Fraction;
+use super::values::{AtLeastOne, Fraction, Gaussian, Shapes};
 
 /// A link: mass, centre of mass and inertia tensor about it, in the link frame.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -172,6 +172,50 @@ pub struct SerialJointsTable {
     pub names: [String; 3],
 }
 
+/// `[monte_carlo]`: the Monte Carlo runs over the joint friction (Section 6.5, Eq. 6.12): the
+/// campaign's defaults and, per joint, the Gaussians the drive friction is drawn from.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SerialMonteCarloTable {
+    #[serde(deserialize_with = "AtLeastOne::checked")]
+    pub runs_per_velocity: u32,
+    /// Draws outside mu +- truncation_sigmas sigma are redrawn.
+    #[serde(deserialize_with = "Positive::checked")]
+    pub truncation_sigmas: f64,
+    #[serde(deserialize_with = "super::tables::velocities")]
+    pub velocities_m_per_s: Vec<f64>,
+    /// `[monte_carlo.friction.<joint>]`, per joint name of `[joints] names`.
+    pub friction: BTreeMap<String, FrictionDistributionTable>,
+}
+
+/// `[monte_carlo.friction.<joint>]`: the Gaussians N(mu, sigma^2) of the fields of
+/// `[drives.<joint>.friction]` drawn per run (identical for every leg); a field left out is
+/// not drawn and keeps the drive's value.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionDistributionTable {
+    #[serde(default, deserialize_with = "positive_gaussian")]
+    pub tau_f_d: Option<Gaussian>,
+    #[serde(default, deserialize_with = "non_negative_gaussian")]
+    pub f_v: Option<Gaussian>,
+}
+
+fn positive_gaussian<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Option<Gaussian>, D::Error> {
+    Positive::gaussian(d).map(Some)
+}
+
+fn non_negative_gaussian<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Option<Gaussian>, D::Error> {
+    NonNegative::gaussian(d).map(Some)
+}
+
+impl FrictionDistributionTable {
+    /// The drawn fields, as (key of `[model.joint_friction.<joint>]`, Gaussian), in the order
+    /// of the drive's friction table.
+    pub fn drawn(&self) -> impl Iterator<Item = (&'static str, Gaussian)> {
+        [("tau_f_d", self.tau_f_d), ("f_v", self.f_v)].into_iter().filter_map(|(k, g)| g.map(|g| (k, g)))
+    }
+}
+
 /// The file, as written.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -184,6 +228,17 @@ pub struct SerialDescriptionFile {
     pub drives: BTreeMap<String, DriveTable>,
     pub controller: SerialControllerTable,
     pub ground: GroundTable,
+    pub monte_carlo: Option<SerialMonteCarloTable>,
+}
+
+/// The Monte Carlo set-up of a serial robot, validated: the friction Gaussians per joint of a
+/// leg, in the order of the joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SerialMonteCarlo {
+    pub runs_per_velocity: u32,
+    pub truncation_sigmas: f64,
+    pub velocities_m_per_s: Vec<f64>,
+    pub friction: [FrictionDistributionTable; 3],
 }
 
 /// A joint's drive, validated.
@@ -215,6 +270,8 @@ pub struct SerialRobot {
     pub period: f64,
     pub supply_voltage: f64,
     pub ground: GroundTable,
+    /// `[monte_carlo]`, when the description has one.
+    pub monte_carlo: Option<SerialMonteCarlo>,
 }
 
 fn pose(xyz: [f64; 3], rpy: [f64; 3]) -> Htm {
@@ -312,6 +369,7 @@ impl SerialRobot {
         if let Some(extra) = f.drives.keys().find(|k| !f.joints.names.contains(k)) {
             return Err(c.err(&format!("drives.{extra}"), format!("[drives.{extra}]"), "no such joint", format!("one table per joint of joints.names: {}", f.joints.names.join(", "))));
         }
+        let monte_carlo = f.monte_carlo.as_ref().map(|m| monte_carlo(c, m, &f.joints.names)).transpose()?;
         let mut legs: [SerialLeg; LEG_COUNT] = legs.try_into().expect("six legs");
         crate::description::urdf::number_serial_legs(&mut legs).map_err(|problem| c.err("legs", "the leg mounts", &problem, "three legs on each side (y > 0 left, y < 0 right) in the order 0, 2, 4 on the left from front to rear, 1, 3, 5 on the right"))?;
         let robot = SerialRobot {
@@ -323,6 +381,7 @@ impl SerialRobot {
             period: f.controller.period_s,
             supply_voltage: f.controller.supply_voltage_v,
             ground: f.ground.clone(),
+            monte_carlo,
         };
         check_one_drive_kind(&robot, c)?;
         Ok(robot)
@@ -372,6 +431,18 @@ impl SerialRobot {
     /// Whether the motors are driven by position servos (the inputs are goal positions).
     pub fn has_servos(&self) -> bool {
         self.drives.iter().all(|d| matches!(d.control, DriveControl::Servo(_)))
+    }
+
+    /// The master's friction feed-forward for the servos ([`FrictionFeedForward`]; None
+    /// without servos) at the control period `dt`: per joint the voltage whose stall torque is
+    /// the drive's dry friction, τ_f,d R / (n k_t) (Eq. 4.4-4.6 at q' = 0), and the linear zone
+    /// ε of its friction law.
+    pub fn friction_feedforward(&self, dt: f64) -> Option<FrictionFeedForward> {
+        let voltage = |k: usize| {
+            let d = self.drive(k);
+            d.friction.tau_f_d * d.motor.resistance_ohm / (d.gear_ratio * d.motor.torque_constant_nm_per_a)
+        };
+        self.has_servos().then(|| FrictionFeedForward::new(std::array::from_fn(|k| self.servo(k)), std::array::from_fn(voltage), std::array::from_fn(|k| self.drive(k).friction.linear_zone), dt))
     }
 
     fn servo(&self, k: usize) -> PositionServo {
@@ -451,6 +522,18 @@ fn friction_element(f: &FrictionSpec, model: FrictionModel) -> FrictionElement {
     FrictionElement::new(law)
 }
 
+/// Validates `[monte_carlo]`: a table per joint of `names` at most, and something drawn.
+fn monte_carlo(c: &Ctx, m: &SerialMonteCarloTable, names: &[String; 3]) -> Result<SerialMonteCarlo> {
+    if let Some(extra) = m.friction.keys().find(|k| !names.contains(k)) {
+        return Err(c.err(&format!("monte_carlo.friction.{extra}"), format!("[monte_carlo.friction.{extra}]"), "no such joint", format!("a table per joint of joints.names: {}", names.join(", "))));
+    }
+    let friction: [FrictionDistributionTable; 3] = std::array::from_fn(|j| m.friction.get(&names[j]).cloned().unwrap_or_default());
+    if friction.iter().all(|t| t.drawn().next().is_none()) {
+        return Err(c.err("monte_carlo.friction", "no Gaussian", "nothing to draw", format!("a [monte_carlo.friction.<joint>] table with tau_f_d and/or f_v = {{ mu = ..., sigma = ... }} for a joint of {}", names.join(", "))));
+    }
+    Ok(SerialMonteCarlo { runs_per_velocity: m.runs_per_velocity, truncation_sigmas: m.truncation_sigmas, velocities_m_per_s: m.velocities_m_per_s.clone(), friction })
+}
+
 /// Checks that every drive is of one kind: position servos on some joints and the master's
 /// voltages on others would need two kinds of inputs.
 fn check_one_drive_kind(robot: &SerialRobot, c: &Ctx) -> Result<()> {
@@ -523,6 +606,18 @@ impl SerialRobot {
             "\n[ground]\np_k = {:?}\np_d = {:?}\nk_gnd_n_per_m_pk = {:?}\nd_gnd_ns_per_m_pd1 = {:?}\nmu = {:?}\nv_glim_m_per_s = {:?}\n",
             g.p_k, g.p_d, g.k_gnd_n_per_m_pk, g.d_gnd_ns_per_m_pd1, g.mu, g.v_glim_m_per_s
         );
+        if let Some(m) = &self.monte_carlo {
+            let v = m.velocities_m_per_s.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
+            out += &format!("\n[monte_carlo]\nruns_per_velocity = {}\ntruncation_sigmas = {:?}\nvelocities_m_per_s = [{v}]\n", m.runs_per_velocity, m.truncation_sigmas);
+            for (name, t) in names.iter().zip(&m.friction) {
+                if t.drawn().next().is_some() {
+                    out += &format!("[monte_carlo.friction.{name}]\n");
+                    for (key, g) in t.drawn() {
+                        out += &format!("{key} = {{ mu = {:?}, sigma = {:?} }}\n", g.mu, g.sigma);
+                    }
+                }
+            }
+        }
         out
     }
 
@@ -606,7 +701,7 @@ mod tests {
     #[test]
     fn the_format_page_documents_every_key() {
         let page = include_str!("../../../../docs/robot-format.md");
-        let tables: [(&str, &[&str]); 11] = [
+        let tables: [(&str, &[&str]); 13] = [
             ("## Top level", struct_fields::<SerialDescriptionFile>()),
             ("## `[joints]`", struct_fields::<SerialJointsTable>()),
             ("## `[base]`", struct_fields::<LinkTable>()),
@@ -618,6 +713,8 @@ mod tests {
             ("### `[drives.<joint>.servo]`", struct_fields::<ServoSpec>()),
             ("### `[drives.<joint>.pi]`", struct_fields::<PiSpec>()),
             ("## `[controller]`", struct_fields::<SerialControllerTable>()),
+            ("## `[monte_carlo]`", struct_fields::<SerialMonteCarloTable>()),
+            ("### `[monte_carlo.friction.<joint>]`", struct_fields::<FrictionDistributionTable>()),
         ];
         let ground = ("## `[ground]`", struct_fields::<GroundTable>());
         let section_keys = |heading: &str| -> Vec<String> {
@@ -634,7 +731,7 @@ mod tests {
             let mut documented = section_keys(heading);
             documented.sort();
             // The tables of tables are documented in their own sections.
-            let mut expected: Vec<String> = fields.iter().filter(|f| !["joints", "base", "legs", "drives", "controller", "ground", "motor", "friction", "servo", "pi"].contains(f) || (*heading == "## `[[legs]]`" && **f == "joints")).map(|f| f.to_string()).collect();
+            let mut expected: Vec<String> = fields.iter().filter(|f| !["joints", "base", "legs", "drives", "controller", "ground", "monte_carlo", "motor", "friction", "servo", "pi"].contains(f) || (*heading == "## `[[legs]]`" && **f == "joints")).map(|f| f.to_string()).collect();
             expected.sort();
             assert_eq!(documented, expected, "{heading}");
         }

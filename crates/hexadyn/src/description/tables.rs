@@ -633,7 +633,7 @@ pub struct MonteCarloTable {
     pub q_h: MonteCarloHorizontalTable,
 }
 
-fn velocities<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+pub(super) fn velocities<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
     seq::<f64, Positive, D>(d, |v| v.is_empty().then(|| Violation::new("[]", "empty", "at least one velocity > 0")))
 }
 

@@ -190,11 +190,12 @@ fn bisect(h: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, mut ha: f64) -> f64 {
 /// max of f over [a, b]: the best of n + 1 samples, refined by golden-section search in the
 /// bracket around it.
 fn maximize(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
-    argmax(f, a, b, n).1
+    argmax(f, a, b, n, 0.0).1
 }
 
-/// [`maximize`] with the argument: (x, f(x)) of the best value met.
-pub(super) fn argmax(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64, f64) {
+/// [`maximize`] with the argument: (x, f(x)) of the best value met. The golden-section search
+/// stops when its bracket is narrower than `tolerance` (in x), or than the rounding of x.
+pub(super) fn argmax(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize, tolerance: f64) -> (f64, f64) {
     let x = |i: usize| a + (b - a) * i as f64 / n as f64;
     let (mut i_best, mut best) = (0, f(a));
     let mut x_best = a;
@@ -209,7 +210,7 @@ pub(super) fn argmax(f: &dyn Fn(f64) -> f64, a: f64, b: f64, n: usize) -> (f64, 
     let (mut c, mut d) = (hi - g * (hi - lo), lo + g * (hi - lo));
     let (mut fc, mut fd) = (f(c), f(d));
     for _ in 0..200 {
-        if hi - lo <= 4.0 * f64::EPSILON * (lo.abs() + hi.abs()) {
+        if hi - lo <= tolerance.max(4.0 * f64::EPSILON * (lo.abs() + hi.abs())) {
             break;
         }
         if fc >= fd {

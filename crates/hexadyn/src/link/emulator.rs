@@ -278,7 +278,7 @@ impl Slaves {
             self.report.history.push(EmulatedPeriod { seq: command.seq, duties: command.duties, counts, body, t: state.t });
         }
         let voltages = command.duties.map(|d| d.voltage(supply));
-        self.robot.actuate(&Command { voltages, references: [0.0; JOINTS] });
+        self.robot.actuate(&Command { voltages, references: [0.0; JOINTS], goals: None });
         self.report.commands += 1;
         let stepping = Instant::now();
         let stepped = self.robot.wait_period();

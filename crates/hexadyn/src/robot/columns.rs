@@ -18,6 +18,7 @@
 //! | `q_r[i]`, `q_v[i]`, `q_h[i]` | rad, m, m | joints of leg i |
 //! | `q_r_dot[i]` ... | rad/s, m/s | joint velocities |
 //! | `q_r_ref[i]` ... | rad, m | joint references (modes `pi` and `gait`) |
+//! | `coxa_goal[i]` ... | rad, m | goals sent to position servos with `gait.friction_feedforward` |
 //! | `X_ref`, `Y_ref`, `Z_ref`; `yaw_ref`, `pitch_ref`, `roll_ref` | m; rad | desired body pose T*_{0,b} (gait) |
 //! | `X_dot_ref`, `Y_dot_ref`; `omega_z_ref` | m/s; rad/s | commanded heading velocities (gait) |
 //! | `duty_factor` | 1 | β of the current gait pattern (gait) |
@@ -88,6 +89,9 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     rec.put_each(&qd[6..6 + JOINTS], |k| (joints.column("", k, "_dot"), joints.unit(k, ("rad/s", "m/s")), format!("joint velocity, leg {}", k / 3)));
     if groups.references {
         rec.put_each(&cmd.references, |k| (joints.column("", k, "_ref"), joints.unit(k, ("rad", "m")), format!("PI reference computed at t, leg {}", k / 3)));
+        if let Some(goals) = &cmd.goals {
+            rec.put_each(goals, |k| (joints.column("", k, "_goal"), joints.unit(k, ("rad", "m")), format!("servo goal sent at t (reference plus friction feed-forward), leg {}", k / 3)));
+        }
     }
     if let Some(g) = gait {
         record_gait(rec, g);

@@ -344,10 +344,11 @@ impl Robot {
     /// Holds a command for the next control period. Digital control: the voltages, cut by the
     /// limit switches of the joints that are beyond their stroke and pushed further out
     /// (Section 2.3.1), read at the control instant as the slave boards apply the commands.
-    /// Continuous PID control: the references.
+    /// Continuous PID control: the references; position servos: the goals (the references
+    /// unless the master adds a feed-forward).
     pub fn command(&mut self, command: &Command, q: &[f64]) {
         if self.model.takes_references() {
-            self.references = command.references;
+            self.references = command.goals.unwrap_or(command.references);
         } else {
             for k in 0..JOINTS {
                 self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k]);

@@ -279,16 +279,11 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
 
     // Model.
     let m = &raw.model;
-    match &mut robot {
-        Robot::Pantograph(d) => m.joint_friction.apply(c, d).map_err(e)?,
-        Robot::Serial(_) => {
-            if !m.joint_friction.is_empty() {
-                return Err(e(c.err("model.joint_friction", "[model.joint_friction]", "a pantograph table on serial legs", "no [model.joint_friction] with a serial robot: its friction is in [drives.<joint>.friction] of its description")));
-            }
-            if m.load_dependence {
-                return Err(e(c.err("model.load_dependence", "true", "no load dependence on serial legs", "false with a serial robot (Eq. 5.12 is identified on AMRU5's horizontal joints)")));
-            }
-        }
+    // The robot as its file describes it: what the master knows (its friction feed-forward).
+    let described = robot.clone();
+    m.joint_friction.apply(c, &mut robot).map_err(e)?;
+    if matches!(robot, Robot::Serial(_)) && m.load_dependence {
+        return Err(e(c.err("model.load_dependence", "true", "no load dependence on serial legs", "false with a serial robot (Eq. 5.12 is identified on AMRU5's horizontal joints)")));
     }
     let mut model = robot.model_options(m.friction);
     if m.load_dependence && m.friction == FrictionModel::None {
@@ -356,7 +351,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     // Control mode and the walking set-up: in gait mode the initial joints come from the gait.
     let mode = raw.control.mode;
     let gait = match (mode, &raw.gait) {
-        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, dir, h.duration_s).map_err(e)?),
+        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, &described, dir, h.duration_s).map_err(e)?),
         (ControlMode::Gait, None) => {
             return Err(e(c.err("gait", "<missing>", "missing table", "a [gait] table with control.mode = \"gait\" (period_s, pattern, [gait.heading]; see the shipped walking scenarios)")));
         }

@@ -18,7 +18,7 @@ use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDet
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
-use crate::control::{joint_pis, Controller};
+use crate::control::{joint_pis, Controller, FrictionFeedForward};
 use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::Robot;
@@ -83,6 +83,8 @@ pub(super) struct RawGait {
     clearance_m: Option<f64>,
     #[serde(default)]
     navigation: bool,
+    #[serde(default)]
+    friction_feedforward: bool,
     body_height_m: Option<f64>,
     heading: RawHeading,
     #[serde(default)]
@@ -245,6 +247,11 @@ pub struct GaitScenario {
     pub heading: HeadingSpec,
     /// Whether the controller receives the true body pose.
     pub navigation: bool,
+    /// The friction feed-forward the master adds to its servo goals
+    /// ([`crate::control::FrictionFeedForward`]; servo robots only), built from the robot as its
+    /// file describes it: the friction the master knows, not a `[model.joint_friction]`
+    /// override (a Monte Carlo draw).
+    pub friction_feedforward: Option<FrictionFeedForward>,
     /// Height of the body frame above the ground the workspaces are computed for (m).
     pub body_height: f64,
     pub legs: GaitLegs,
@@ -272,9 +279,15 @@ impl GaitScenario {
         let pis = joint_pis(&robot.pi_gains(), self.options.dt);
         match (&self.free, &self.legs) {
             (Some(free), GaitLegs::Pantograph(legs)) => self.published(FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt))),
-            (Some(free), GaitLegs::Serial(legs)) => self.published(FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt))),
+            (Some(free), GaitLegs::Serial(legs)) => {
+                let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
+                self.published(controller.with_friction_feedforward(self.friction_feedforward.clone()))
+            }
             (None, GaitLegs::Pantograph(legs)) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
-            (None, GaitLegs::Serial(legs)) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
+            (None, GaitLegs::Serial(legs)) => {
+                let controller = GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source());
+                self.scheduled(controller.with_friction_feedforward(self.friction_feedforward.clone()))
+            }
         }
     }
 
@@ -324,7 +337,10 @@ fn duty_factor(c: &Ctx, field: &str, kind: GaitKind, value: Option<f64>, cycle: 
 }
 
 /// Validates the `[gait]` table. `duration` is the scenario's (s).
-pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
+///
+/// `described` is the robot as its file describes it, before the scenario's friction
+/// overrides: the master's friction feed-forward is built from it.
+pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
     let dt = robot.period();
     let periodic = match g.pattern.periodic() {
         Some(kind) => Some(periodic_pattern(g, c, kind, dt, duration)?),
@@ -342,7 +358,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
     let heading = || validate_heading(&g.heading, c, dir);
     let no_kinematics = |e: LegKinematicsError, what: &str| c.err("scenario.robot", robot.origin(), &format!("no leg kinematics: {e}"), what);
 
-    match robot {
+    let gait = match robot {
         Robot::Pantograph(d) => {
             let legs = LegKinematics::hexapod_from_description(d).map_err(|e| no_kinematics(e, "a robot description whose pantograph closes over the joint ranges"))?;
             let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
@@ -363,7 +379,13 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, dir: &Path, duration
             }
             .map(|w| w.on(GaitLegs::Serial(legs), stance))
         }
-    }
+    }?;
+    let friction_feedforward = match (g.friction_feedforward, described.friction_feedforward(dt)) {
+        (false, _) => None,
+        (true, Some(f)) => Some(f),
+        (true, None) => return Err(c.err("gait.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)")),
+    };
+    Ok(GaitScenario { friction_feedforward, ..gait })
 }
 
 /// The body height of a gait and the workspace cylinders of the legs at it.
@@ -433,7 +455,7 @@ struct Walking {
 
 impl Walking {
     fn on(self, legs: GaitLegs, stance: Stance) -> GaitScenario {
-        GaitScenario { options: self.options, free: self.free, heading: self.heading, navigation: self.navigation, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
+        GaitScenario { options: self.options, free: self.free, heading: self.heading, navigation: self.navigation, friction_feedforward: None, body_height: stance.height, legs, workspaces: stance.workspaces, changes: self.changes, joints: self.joints }
     }
 }
 

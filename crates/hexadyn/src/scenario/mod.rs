@@ -64,6 +64,7 @@ pub use crate::control::gait::schedule::GaitChange;
 pub use gait::{FreeGaitSpec, GaitLegs, GaitScenario, HeadingSpec, LandingSpec, DEFAULT_CLEARANCE, DEFAULT_DUTY_FACTOR, DEFAULT_OVERLAP};
 pub use overrides::Override;
 pub use drivers::{GaitColumns, ScenarioController};
+pub use joint_friction::{physical_bounds, serial_parameters};
 pub use run::settled_robot;
 pub use run::{run_scenario, run_scenario_chunked, run_scenario_until, Record, ScenarioResults};
 pub use summary::{per_joint_entries, specific_resistance, GaitSummary, Summary, SummaryValue};

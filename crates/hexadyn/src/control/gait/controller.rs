@@ -12,7 +12,7 @@ use super::body_motion::{BodyMotion, Pose};
 use super::walk::{LegState, Walk};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
-use crate::control::{pi_command, BodyPose, Command, Controller, DigitalPi, Measurements};
+use crate::control::{pi_command, BodyPose, Command, Controller, DigitalPi, FrictionFeedForward, Measurements};
 use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -78,6 +78,8 @@ pub struct GaitController<L: LegMechanism = LegKinematics> {
     legs_kinematics: [L; 6],
     workspaces: [Workspace; 6],
     pis: [DigitalPi; JOINTS],
+    /// The servo goals' friction feed-forward, when the master adds one.
+    feedforward: Option<FrictionFeedForward>,
     heading: Box<dyn HeadingSource>,
     walk: Walk<Leg>,
     /// Time of the gait's origin (phase 0 of the pattern).
@@ -89,7 +91,12 @@ pub struct GaitController<L: LegMechanism = LegKinematics> {
 impl<L: LegMechanism> GaitController<L> {
     pub fn new(options: GaitOptions, legs: [L; 6], workspaces: [Workspace; 6], pis: [DigitalPi; JOINTS], heading: Box<dyn HeadingSource>) -> Self {
         let idle = Leg { phase: FootPhase::Support, anchor: Vector3::zeros(), swing_xy: Vector3::zeros(), swing_from: Vector3::zeros(), aep: Vector3::zeros(), swing_time: 0.0, foot: Vector3::zeros(), joints: Vector3::zeros() };
-        GaitController { options, legs_kinematics: legs, workspaces, pis, heading, walk: Walk { body: None, legs: [idle; 6] }, origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
+        GaitController { options, legs_kinematics: legs, workspaces, pis, feedforward: None, heading, walk: Walk { body: None, legs: [idle; 6] }, origin: 0.0, pending: None, diagnostics: GaitDiagnostics::default() }
+    }
+
+    /// The same controller sending its servos the goals of `feedforward` (none: the references).
+    pub fn with_friction_feedforward(self, feedforward: Option<FrictionFeedForward>) -> Self {
+        GaitController { feedforward, ..self }
     }
 
     pub fn workspaces(&self) -> &[Workspace; 6] {
@@ -377,7 +384,8 @@ impl<L: LegMechanism> Controller for GaitController<L> {
             self.walk.legs[l] = next;
             references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
         }
-        pi_command(&mut self.pis, references, m)
+        let goals = self.feedforward.as_mut().map(|f| f.goals(&references, m.supply_voltage));
+        Command { goals, ..pi_command(&mut self.pis, references, m) }
     }
 }
 

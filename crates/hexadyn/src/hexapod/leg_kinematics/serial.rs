@@ -72,9 +72,12 @@ impl SerialLegKinematics {
 /// Directions and heights at which the workspace's radius is measured.
 const DIRECTIONS: usize = 16;
 const HEIGHTS: usize = 3;
-/// March step (m) and bisection steps of the boundary search.
+/// March step (m) and bisection steps of the boundary search: 5 mm / 2^14, 0.3 µm.
 const STEP: f64 = 0.005;
-const BISECTIONS: usize = 20;
+const BISECTIONS: usize = 14;
+/// Width (m) at which the search for the cylinder's axis stops: a micrometre of the
+/// workspace's centre is far below what a foothold needs.
+const AXIS_TOLERANCE: f64 = 1e-6;
 
 impl SerialLegKinematics {
     /// Joints reaching `target` by Eq. 7.7 from `start` alone (no closest-point search).
@@ -154,7 +157,9 @@ impl SerialLegKinematics {
         if z_min > z_max {
             return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
         }
-        let heights: Vec<f64> = (0..HEIGHTS).map(|k| z_min + (z_max - z_min) * k as f64 / (HEIGHTS - 1) as f64).collect();
+        // One height for a flat cylinder (a stance at one height).
+        let n = if z_max > z_min { HEIGHTS } else { 1 };
+        let heights: Vec<f64> = (0..n).map(|k| z_min + (z_max - z_min) * k as f64 / (n - 1).max(1) as f64).collect();
         let middle = self.foot(&self.limits.middle());
         let bisector = nalgebra::Vector2::new(middle.x, middle.y);
         let reach = self.origins.iter().skip(1).map(|o| o.translation.norm()).sum::<f64>() + self.foot.norm();
@@ -162,7 +167,7 @@ impl SerialLegKinematics {
             return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
         }
         let u = bisector.normalize();
-        let (d, radius) = argmax(&|d| self.radius_about(&(u * d), &heights, reach), 0.0, reach, 24);
+        let (d, radius) = argmax(&|d| self.radius_about(&(u * d), &heights, reach), 0.0, reach, 24, AXIS_TOLERANCE);
         if !(radius > 0.0) {
             return Err(LegKinematicsError::EmptyWorkspace { z_min, z_max });
         }

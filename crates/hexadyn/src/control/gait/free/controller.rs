@@ -23,7 +23,7 @@ use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
-use crate::control::{pi_command, Command, Controller, DigitalPi, Measurements, DIGITAL_CUTOFF_HZ};
+use crate::control::{pi_command, Command, Controller, DigitalPi, FrictionFeedForward, Measurements, DIGITAL_CUTOFF_HZ};
 use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -130,6 +130,8 @@ pub struct FreeGaitController<L: LegMechanism = LegKinematics> {
     legs_kinematics: [L; 6],
     workspaces: [Workspace; 6],
     pis: [DigitalPi; JOINTS],
+    /// The friction feed-forward of the servo goals, as the periodic gait's.
+    feedforward: Option<FrictionFeedForward>,
     heading: Box<dyn HeadingSource>,
     landing: Box<dyn LandingDetector>,
     neighbours: [Option<(usize, usize)>; 6],
@@ -168,6 +170,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
             legs_kinematics: legs,
             workspaces,
             pis,
+            feedforward: None,
             heading,
             landing,
             neighbours,
@@ -180,6 +183,12 @@ impl<L: LegMechanism> FreeGaitController<L> {
             state: FreeGaitState::default(),
             diagnostics: GaitDiagnostics::default(),
         }
+    }
+
+    /// The same controller sending its servos the goals of `feedforward` (none: the references),
+    /// as [`GaitController::with_friction_feedforward`](crate::control::gait::controller::GaitController::with_friction_feedforward).
+    pub fn with_friction_feedforward(self, feedforward: Option<FrictionFeedForward>) -> Self {
+        FreeGaitController { feedforward, ..self }
     }
 
     pub fn state(&self) -> FreeGaitState {
@@ -615,7 +624,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         let angles = m.pose.map_or(body.pose.angles, |p| pose_of(&p).angles);
         (self.state.pitch, self.state.roll) = (angles.y, angles.z);
 
-        pi_command(&mut self.pis, references, m)
+        let goals = self.feedforward.as_mut().map(|f| f.goals(&references, m.supply_voltage));
+        Command { goals, ..pi_command(&mut self.pis, references, m) }
     }
 }
 
