@@ -457,9 +457,12 @@ fn walking_scenarios_parse() {
     let px = "phantomx_free_gait_rough";
     let terrain = format!("file = \"{}/terrains/", scenarios_dir().display());
     let px_with = |from: &str, to: &str| with(px, from, to).replace("file = \"terrains/", &terrain);
-    assert_eq!(landing(&px_with("", "")), LandingSpec::Force { threshold: 0.54 });
-    assert_eq!(landing(&px_with("landing = \"force\"", "")), LandingSpec::Force { threshold: 0.54 });
-    assert_eq!(landing(&px_with("landing = \"force\"", "").replace("landing_threshold_n = 0.54", "")), LandingSpec::Force { threshold: 10.0 });
+    // At Section 7.7's 10 N scaled from AMRU5's weight to the robot's (0.54 N on the PhantomX).
+    let scaled = 10.0 * Robot::from_str(hexadyn::description::PHANTOMX_TOML, "phantomx").unwrap().total_mass_kg() / Robot::from_str(AMRU5_TOML, "amru5").unwrap().total_mass_kg();
+    assert!((scaled - 0.535).abs() < 0.001, "{scaled}");
+    assert_eq!(landing(&px_with("", "")), LandingSpec::Force { threshold: scaled });
+    assert_eq!(landing(&px_with("landing = \"force\"", "")), LandingSpec::Force { threshold: scaled });
+    assert_eq!(landing(&px_with("landing = \"force\"", "landing_threshold_n = 10.0")), LandingSpec::Force { threshold: 10.0 });
 
     // Waypoints of a spline.
     let text = with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 50.0, 100.0]\nx_m = [0.0, 0.5, 1.0]\ny_m = [0.0, 0.2, 0.0]");

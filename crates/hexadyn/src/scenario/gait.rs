@@ -364,7 +364,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, d
             let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Current),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Current, THESIS_FORCE_THRESHOLD),
                 Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
             .map(|w| w.on(GaitLegs::Pantograph(legs), stance))
@@ -374,7 +374,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, d
             let stance = stance(g, c, &legs, default_serial_height(&legs), " (the default: the feet with every joint at mid-range)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Force),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Force, weighted_force_threshold(robot)),
                 Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
             .map(|w| w.on(GaitLegs::Serial(legs), stance))
@@ -528,12 +528,22 @@ pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
 /// mass move apart when the body pitches by 2° at the 0.41 m body height, plus the foot radius.
 pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 
+/// The default threshold of the normal-force landing on a robot other than AMRU5: Section 7.7's
+/// 10 N at the same share of the robot's weight as of AMRU5's. INTERPRETATION: 10 N is 3 % of
+/// AMRU5's weight; on the 1.8 kg PhantomX it would be 55 %, reached only once the leg carries
+/// half the body, and its free gait clamps its references and halts after 0.10 m.
+fn weighted_force_threshold(robot: &Robot) -> f64 {
+    THESIS_FORCE_THRESHOLD * robot.total_mass_kg() / crate::description::RobotDescription::amru5().total_mass_kg()
+}
+
 /// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
 /// its workspace centre, a failed leg held up at the top of its workspace. `default_landing`:
 /// the landing detection without a `landing` field; serial legs (`LandingKind::Force`) refuse
 /// the motor currents, whose ground detection (Section 5.6.3) is the pantograph's.
+/// `force_threshold`: the default threshold of the normal-force landing (Section 7.7's 10 N on
+/// AMRU5).
 #[allow(clippy::too_many_arguments)]
-fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, default_landing: LandingKind) -> Result<Walking> {
+fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, default_landing: LandingKind, force_threshold: f64) -> Result<Walking> {
     let Stance { height, workspaces, given } = *stance;
     let default = RawFree::default();
     let raw = g.free.as_ref().unwrap_or(&default);
@@ -548,13 +558,13 @@ fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], 
     let landing = match (raw.landing, default_landing) {
         (None, default) => default,
         (Some(LandingKind::Current), LandingKind::Force) => {
-            return Err(c.err("gait.free.landing", "\"current\"", "the ground detection from the motor currents (Section 5.6.3) needs the pantograph's vertical joint", "landing = \"force\" with serial legs (the true normal force above landing_threshold_n, Section 7.7: 10 N), or no landing field"));
+            return Err(c.err("gait.free.landing", "\"current\"", "the ground detection from the motor currents (Section 5.6.3) needs the pantograph's vertical joint", "landing = \"force\" with serial legs (the true normal force above landing_threshold_n, default Section 7.7's 10 N scaled to the robot's weight), or no landing field"));
         }
         (Some(kind), _) => kind,
     };
     let (default_threshold, allowed) = match landing {
         LandingKind::Current => (THESIS_CURRENT_THRESHOLD, "an estimated vertical ground force > 0 N with landing = \"current\" (default 40 N, the lowest threshold of Section 5.6.3)"),
-        LandingKind::Force => (THESIS_FORCE_THRESHOLD, "a normal force > 0 N with landing = \"force\" (Section 7.7: 10 N)"),
+        LandingKind::Force => (force_threshold, "a normal force > 0 N with landing = \"force\" (default: Section 7.7's 10 N at the share of the robot's weight it is of AMRU5's)"),
     };
     let threshold = raw.landing_threshold_n.unwrap_or(default_threshold);
     c.check(threshold.is_finite() && threshold > 0.0, "gait.free.landing_threshold_n", threshold, allowed)?;
