@@ -3,7 +3,7 @@
 use std::f64::consts::TAU;
 
 use super::interface::{Command, Controller, Measurements};
-use super::DigitalPi;
+use super::{DigitalPi, FrictionFeedForward};
 use crate::description::PiGains;
 use crate::hexapod::JOINTS;
 
@@ -18,6 +18,13 @@ pub fn joint_pis(gains: &[PiGains; JOINTS], dt: f64) -> [DigitalPi; JOINTS] {
 pub fn pi_command(pis: &mut [DigitalPi; JOINTS], references: [f64; JOINTS], m: &Measurements) -> Command {
     let voltages = std::array::from_fn(|k| pis[k].update(references[k] - m.positions[k], m.supply_voltage));
     Command { voltages, references, goals: None }
+}
+
+/// [`pi_command`] with the servo goals of the master's friction feed-forward when it adds one
+/// (the last stage of the gait controllers, which drive PI loops or position servos).
+pub fn joint_command(pis: &mut [DigitalPi; JOINTS], feedforward: Option<&mut FrictionFeedForward>, references: [f64; JOINTS], m: &Measurements) -> Command {
+    let goals = feedforward.map(|f| f.goals(&references, m.supply_voltage));
+    Command { goals, ..pi_command(pis, references, m) }
 }
 
 /// Joint references q_d(t).

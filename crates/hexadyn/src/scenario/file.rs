@@ -279,8 +279,9 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
 
     // Model.
     let m = &raw.model;
-    // The robot as its file describes it: what the master knows (its friction feed-forward).
-    let described = robot.clone();
+    // The master's friction feed-forward knows the robot as its file describes it, not the
+    // overrides below.
+    let feedforward = robot.friction_feedforward(period);
     m.joint_friction.apply(c, &mut robot).map_err(e)?;
     if matches!(robot, Robot::Serial(_)) && m.load_dependence {
         return Err(e(c.err("model.load_dependence", "true", "no load dependence on serial legs", "false with a serial robot (Eq. 5.12 is identified on AMRU5's horizontal joints)")));
@@ -351,7 +352,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     // Control mode and the walking set-up: in gait mode the initial joints come from the gait.
     let mode = raw.control.mode;
     let gait = match (mode, &raw.gait) {
-        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, &described, dir, h.duration_s).map_err(e)?),
+        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, feedforward, dir, h.duration_s).map_err(e)?),
         (ControlMode::Gait, None) => {
             return Err(e(c.err("gait", "<missing>", "missing table", "a [gait] table with control.mode = \"gait\" (period_s, pattern, [gait.heading]; see the shipped walking scenarios)")));
         }

@@ -18,7 +18,7 @@ use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDet
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
-use crate::control::{joint_pis, Controller, FrictionFeedForward};
+use crate::control::{joint_pis, Controller, DigitalPi, FrictionFeedForward};
 use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::Robot;
@@ -278,26 +278,25 @@ impl GaitScenario {
     pub fn controller(&self, robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
         let pis = joint_pis(&robot.pi_gains(), self.options.dt);
         match (&self.free, &self.legs) {
-            (Some(free), GaitLegs::Pantograph(legs)) => self.published(FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt))),
-            (Some(free), GaitLegs::Serial(legs)) => {
-                let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
-                self.published(controller.with_friction_feedforward(self.friction_feedforward.clone()))
-            }
-            (None, GaitLegs::Pantograph(legs)) => self.scheduled(GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source())),
-            (None, GaitLegs::Serial(legs)) => {
-                let controller = GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source());
-                self.scheduled(controller.with_friction_feedforward(self.friction_feedforward.clone()))
-            }
+            (Some(free), GaitLegs::Pantograph(legs)) => self.published(free, legs, pis, robot),
+            (Some(free), GaitLegs::Serial(legs)) => self.published(free, legs, pis, robot),
+            (None, GaitLegs::Pantograph(legs)) => self.scheduled(legs, pis),
+            (None, GaitLegs::Serial(legs)) => self.scheduled(legs, pis),
         }
     }
 
-    fn published<L: Leg + Clone + 'static>(&self, controller: FreeGaitController<L>) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
-        let (c, state) = PublishedFreeGait::new(controller);
+    /// The free gait on `legs`, publishing its state, with the master's friction feed-forward.
+    fn published<L: Leg + Clone + 'static>(&self, free: &FreeGaitSpec, legs: &[L; 6], pis: [DigitalPi; JOINTS], robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
+        let (c, state) = PublishedFreeGait::new(controller.with_friction_feedforward(self.friction_feedforward.clone()));
         (Box::new(c), state)
     }
 
-    fn scheduled<L: Leg + Clone + 'static>(&self, controller: GaitController<L>) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
-        let (c, state) = ScheduledGait::new(controller, self.changes.clone());
+    /// The periodic gait on `legs` with its scheduled changes, with the master's friction
+    /// feed-forward.
+    fn scheduled<L: Leg + Clone + 'static>(&self, legs: &[L; 6], pis: [DigitalPi; JOINTS]) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let controller = GaitController::new(self.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source());
+        let (c, state) = ScheduledGait::new(controller.with_friction_feedforward(self.friction_feedforward.clone()), self.changes.clone());
         (Box::new(c), state)
     }
 }
@@ -338,9 +337,10 @@ fn duty_factor(c: &Ctx, field: &str, kind: GaitKind, value: Option<f64>, cycle: 
 
 /// Validates the `[gait]` table. `duration` is the scenario's (s).
 ///
-/// `described` is the robot as its file describes it, before the scenario's friction
-/// overrides: the master's friction feed-forward is built from it.
-pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, dir: &Path, duration: f64) -> Result<GaitScenario> {
+/// `feedforward` is the master's friction feed-forward for the robot's servos (None without
+/// servos), built from the robot as its file describes it, before the scenario's friction
+/// overrides.
+pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, feedforward: Option<FrictionFeedForward>, dir: &Path, duration: f64) -> Result<GaitScenario> {
     let dt = robot.period();
     let periodic = match g.pattern.periodic() {
         Some(kind) => Some(periodic_pattern(g, c, kind, dt, duration)?),
@@ -380,7 +380,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, described: &Robot, d
             .map(|w| w.on(GaitLegs::Serial(legs), stance))
         }
     }?;
-    let friction_feedforward = match (g.friction_feedforward, described.friction_feedforward(dt)) {
+    let friction_feedforward = match (g.friction_feedforward, feedforward) {
         (false, _) => None,
         (true, Some(f)) => Some(f),
         (true, None) => return Err(c.err("gait.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)")),

@@ -12,7 +12,7 @@ use super::body_motion::{BodyMotion, Pose};
 use super::walk::{LegState, Walk};
 use super::heading::{Heading, HeadingSource};
 use super::pattern::{FootCycle, FootPhase, GaitPattern};
-use crate::control::{pi_command, BodyPose, Command, Controller, DigitalPi, FrictionFeedForward, Measurements};
+use crate::control::{joint_command, BodyPose, Command, Controller, DigitalPi, FrictionFeedForward, Measurements};
 use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -384,8 +384,7 @@ impl<L: LegMechanism> Controller for GaitController<L> {
             self.walk.legs[l] = next;
             references[3 * l..3 * l + 3].copy_from_slice(ik.joints.as_slice());
         }
-        let goals = self.feedforward.as_mut().map(|f| f.goals(&references, m.supply_voltage));
-        Command { goals, ..pi_command(&mut self.pis, references, m) }
+        joint_command(&mut self.pis, self.feedforward.as_mut(), references, m)
     }
 }
 

@@ -23,7 +23,7 @@ use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
-use crate::control::{pi_command, Command, Controller, DigitalPi, FrictionFeedForward, Measurements, DIGITAL_CUTOFF_HZ};
+use crate::control::{joint_command, Command, Controller, DigitalPi, FrictionFeedForward, Measurements, DIGITAL_CUTOFF_HZ};
 use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -624,8 +624,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         let angles = m.pose.map_or(body.pose.angles, |p| pose_of(&p).angles);
         (self.state.pitch, self.state.roll) = (angles.y, angles.z);
 
-        let goals = self.feedforward.as_mut().map(|f| f.goals(&references, m.supply_voltage));
-        Command { goals, ..pi_command(&mut self.pis, references, m) }
+        joint_command(&mut self.pis, self.feedforward.as_mut(), references, m)
     }
 }
 
