@@ -21,7 +21,7 @@ use hexadyn::hexapod::{LegKinematics, JOINTS};
 use hexadyn::physics::FlatGround;
 use hexadyn::robot::model::{FrictionModel, ModelOptions, RobotModel};
 use hexadyn::robot::simulation::{run, PlantOptions, SimulatedRobot};
-use hexadyn::description::RobotDescription;
+use hexadyn::description::{Robot, RobotDescription};
 use nalgebra::Vector3;
 
 const THESIS_WALL_S: f64 = 260.0;
@@ -44,7 +44,7 @@ fn main() {
     // One controller update, open loop on measurements that follow the references.
     let (mut c, joints) = controller(&d, 12.0, 0.015);
     let mut m = Measurements { t: 0.0, positions: joints, currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: None };
-    let mut detector = GroundDetector::new(&d, d.controller.period_s, 40.0).unwrap();
+    let mut detector = GroundDetector::new(&Robot::Pantograph(d.clone()), LegKinematics::hexapod_from_description(&d).unwrap(), d.controller.period_s, 40.0);
     let (mut samples, mut detector_samples) = (Vec::new(), Vec::new());
     for i in 0..30_000 {
         m.t = i as f64 * 0.01;

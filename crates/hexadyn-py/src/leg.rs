@@ -1,9 +1,10 @@
 //! `hexadyn._core.LegModel`: the joint torques of one leg on a still, level body (Eq. 3.37 on a
-//! single leg, `hexadyn::hexapod::leg_joint_torques`), vectorized over samples. The friction
+//! single leg, `hexadyn::hexapod::LegDynamics::leg_joint_torques`), vectorized over samples. The friction
 //! identification removes the gravity contribution with it (Section 5.2.1).
 
 use hexadyn::description::{RobotDescription, AMRU5_TOML};
-use hexadyn::hexapod::{leg_joint_torques, PantographJoint, Mechanics, MechanicsParameters, LEG_COUNT};
+use hexadyn::description::Robot;
+use hexadyn::hexapod::{LegDynamics, PantographJoint, LEG_COUNT};
 use hexadyn::mbs::Data;
 use nalgebra::Vector3;
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -14,7 +15,7 @@ use pyo3::types::PyDict;
 #[pyclass(name = "LegModel", module = "hexadyn._core")]
 pub struct PyLegModel {
     description: RobotDescription,
-    mechanics: Mechanics,
+    dynamics: LegDynamics,
     data: Data,
 }
 
@@ -26,12 +27,11 @@ impl PyLegModel {
     #[pyo3(signature = (robot_text = None, origin = "robot description"))]
     fn new(robot_text: Option<&str>, origin: &str) -> PyResult<Self> {
         let description = crate::schema::pantograph_description(robot_text.unwrap_or(AMRU5_TOML), origin, "friction identification")?;
-        let mechanics = Mechanics::new(&MechanicsParameters::from_description(&description))
-            .map_err(|e| PyValueError::new_err(format!("{origin}: {e}")))?;
-        let data = Data::new(&mechanics.model);
+        let dynamics = Robot::Pantograph(description.clone()).leg_dynamics();
+        let data = Data::new(&dynamics.model);
         Ok(PyLegModel {
             description,
-            mechanics,
+            dynamics,
             data,
         })
     }
@@ -125,8 +125,7 @@ impl PyLegModel {
         let mut out = Vec::with_capacity(n);
         for i in 0..n {
             out.push(
-                leg_joint_torques(
-                    &self.mechanics,
+                self.dynamics.leg_joint_torques(
                     &mut self.data,
                     leg,
                     row(&q, i),

@@ -5,6 +5,7 @@ use std::path::Path;
 use std::rc::Rc;
 
 use hexadyn::control::{Command, Controller, DigitalLowPass, GroundDetector, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
+use hexadyn::hexapod::LegKinematics;
 use hexadyn::robot::recorder::TimeSeries;
 use hexadyn::robot::simulation::run;
 use hexadyn::scenario::{run_scenario, settled_robot, Scenario, ScenarioController};
@@ -117,7 +118,7 @@ fn no_false_detection_over_100_swing_phases() {
     let detections = Rc::new(RefCell::new([LegDetection::default(); 6]));
     struct Spy {
         walk: ScenarioController,
-        detector: GroundDetector,
+        detector: GroundDetector<LegKinematics>,
         out: Rc<RefCell<[LegDetection; 6]>>,
     }
     impl Controller for Spy {
@@ -126,7 +127,7 @@ fn no_false_detection_over_100_swing_phases() {
             self.walk.update(m)
         }
     }
-    let mut spy = Spy { walk: ScenarioController::new(&s), detector: GroundDetector::new(s.robot.pantograph().unwrap(), s.period(), 40.0).unwrap(), out: detections.clone() };
+    let mut spy = Spy { walk: ScenarioController::new(&s), detector: GroundDetector::new(&s.robot, LegKinematics::hexapod_from_description(s.robot.pantograph().unwrap()).unwrap(), s.period(), 40.0), out: detections.clone() };
     let mut plant = settled_robot(&s).unwrap();
     let (mut swings, mut in_air, mut max_lowering) = (0, [false; 6], 0.0f64);
     run(&mut plant, &mut spy, s.duration, |p, _, _| {
@@ -139,7 +140,7 @@ fn no_false_detection_over_100_swing_phases() {
             in_air[l] = air;
             if air {
                 assert!(!d[l].detected, "leg {l} detected in the air: {:?}", d[l]);
-                if d[l].qd_v > 0.0 {
+                if d[l].lowering > 0.0 {
                     max_lowering = max_lowering.max(d[l].force);
                 }
             }

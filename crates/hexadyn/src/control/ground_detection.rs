@@ -3,6 +3,10 @@
 //! the foot by the leg Jacobian (Eq. 5.20-5.22), compared with a threshold while the foot is
 //! being lowered.
 //!
+//! Any leg mechanism ([`GroundSensingLeg`]): AMRU5's pantograph as the thesis writes it (α_21
+//! alone, the vertical joint's velocity), a serial leg on its own Jacobian (the whole vertical
+//! row of J^{−T}, the foot's vertical velocity).
+//!
 //! A gait controller calls [`GroundDetector::update`] once per control period with the
 //! measurements and reads, per leg, the force estimate and the `detected` flag.
 
@@ -11,22 +15,69 @@ use nalgebra::{Matrix3, Vector3};
 use super::interface::Measurements;
 use super::low_pass::DIGITAL_CUTOFF_HZ;
 use super::torque_estimation::{TorqueEstimate, TorqueEstimator};
-use crate::description::RobotDescription;
-use crate::hexapod::{LegKinematics, LegKinematicsError, LEG_COUNT};
+use crate::description::Robot;
+use crate::hexapod::{LegChain, LegKinematics, SerialLegKinematics, LEG_COUNT};
 
 /// What the detector says about one leg at a control instant.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LegDetection {
     /// F̂_z,gnd (N): the estimated vertical ground force on the foot, Eq. 5.22 (> 0 pushing up).
     pub force: f64,
-    /// τ̂_v,gnd = τ_v − τ̂_v (N), Eq. 5.16.
-    pub tau_v_gnd: f64,
-    /// Estimated vertical joint velocity q̂_v' (m/s); > 0 lowers the foot.
-    pub qd_v: f64,
-    /// Ground detected: `force` at or above the threshold while the foot is lowered (q̂_v' > 0),
-    /// the two conditions of Section 5.6.3.
+    /// How fast the foot is lowered, > 0 down ([`GroundSensingLeg::lowering`]: q̂_v' (m/s) on
+    /// the pantograph, the foot's downward velocity (m/s) on other legs).
+    pub lowering: f64,
+    /// The lowering beyond which the joints slide, outside the linear zones ε of their
+    /// dry/viscous laws ([`GroundSensingLeg::sliding_lowering`]).
+    pub sliding_lowering: f64,
+    /// Ground detected: `force` at or above the threshold while the foot is lowered
+    /// (`lowering` > 0), the two conditions of Section 5.6.3.
     pub detected: bool,
 }
+
+/// What the ground detection of Section 5.6.3 asks of a leg mechanism beyond its kinematics:
+/// the vertical ground force from the ground torques of its joints, and how fast its foot is
+/// lowered. The defaults hold for any leg; the pantograph keeps the thesis' simplifications.
+pub trait GroundSensingLeg: LegChain {
+    /// F̂_z,gnd (N) from the ground torques `tau_gnd` of the leg's joints at `q`: the vertical
+    /// row of F = −J^{−T} τ_gnd (Eq. 5.20-5.21); None where J is singular.
+    fn vertical_ground_force(&self, q: &Vector3<f64>, tau_gnd: &Vector3<f64>) -> Option<f64> {
+        Some(-(jacobian_inverse_transpose(self, q)?.row(2) * tau_gnd)[0])
+    }
+
+    /// How fast the foot is lowered at (q, q') (> 0 down): −(J q')_z (m/s).
+    fn lowering(&self, q: &Vector3<f64>, qd: &Vector3<f64>) -> f64 {
+        -(self.foot_and_jacobian(q).1 * qd).z
+    }
+
+    /// The [`Self::lowering`] at which the joints leave the linear zones `epsilon` of their
+    /// dry/viscous laws (Eq. 6.1).
+    ///
+    /// INTERPRETATION: a serial leg lowers its foot with all its joints; the foot is sliding
+    /// once it descends faster than the joint with the longest vertical lever |∂z/∂q_j| does
+    /// when moving at its ε, max_j |J_zj| ε_j.
+    fn sliding_lowering(&self, q: &Vector3<f64>, epsilon: &[f64; 3]) -> f64 {
+        let j = self.foot_and_jacobian(q).1;
+        (0..3).map(|k| j[(2, k)].abs() * epsilon[k]).fold(0.0, f64::max)
+    }
+}
+
+/// AMRU5's pantograph as Section 5.6.3 writes it: Eq. 5.22 keeps α_21 τ_v,gnd, and the foot is
+/// lowered when the vertical joint slides down (q̂_v' > 0, beyond its ε).
+impl GroundSensingLeg for LegKinematics {
+    fn vertical_ground_force(&self, q: &Vector3<f64>, tau_gnd: &Vector3<f64>) -> Option<f64> {
+        alpha(self, q).map(|(a21, _)| a21 * tau_gnd[1])
+    }
+
+    fn lowering(&self, _q: &Vector3<f64>, qd: &Vector3<f64>) -> f64 {
+        qd[1]
+    }
+
+    fn sliding_lowering(&self, _q: &Vector3<f64>, epsilon: &[f64; 3]) -> f64 {
+        epsilon[1]
+    }
+}
+
+impl GroundSensingLeg for SerialLegKinematics {}
 
 /// The coefficients (α_21, α_22) of Eq. 5.21 at the joint positions `q` of `leg`: the vertical
 /// ground force on the foot is F_z = α_21 τ_v,gnd + α_22 τ_h,gnd (α_20 = 0).
@@ -42,8 +93,8 @@ pub fn alpha(leg: &LegKinematics, q: &Vector3<f64>) -> Option<(f64, f64)> {
 }
 
 /// J^{−T} of the leg at q (Eq. 5.20: F = −J^{−T} τ); None where J is singular.
-fn jacobian_inverse_transpose(leg: &LegKinematics, q: &Vector3<f64>) -> Option<Matrix3<f64>> {
-    leg.jacobian(q).transpose().try_inverse()
+fn jacobian_inverse_transpose<L: LegChain + ?Sized>(leg: &L, q: &Vector3<f64>) -> Option<Matrix3<f64>> {
+    leg.foot_and_jacobian(q).1.transpose().try_inverse()
 }
 
 /// The estimator's (filtered) joint positions of `leg`.
@@ -51,26 +102,33 @@ fn leg_joints(e: &TorqueEstimate, leg: usize) -> Vector3<f64> {
     Vector3::new(e.q[3 * leg], e.q[3 * leg + 1], e.q[3 * leg + 2])
 }
 
+/// The estimated ground torques τ − τ̂ of the joints of `leg` (Eq. 5.16).
+fn ground_torques(e: &TorqueEstimate, leg: usize) -> Vector3<f64> {
+    let k = 3 * leg;
+    Vector3::new(e.ground(k), e.ground(k + 1), e.ground(k + 2))
+}
+
 /// The ground detector of the six legs.
 #[derive(Clone, Debug)]
-pub struct GroundDetector {
+pub struct GroundDetector<L> {
     estimator: TorqueEstimator,
-    legs: [LegKinematics; LEG_COUNT],
+    legs: [L; LEG_COUNT],
     /// Detection threshold on F̂_z,gnd (N): 40, 50 or 60 N in Table 5.7.
     pub threshold: f64,
 }
 
-impl GroundDetector {
-    /// The detector of a robot description at the control period `dt`, with the 3 Hz filters
-    /// of Section 5.6.2 and the force `threshold` (N).
-    pub fn new(d: &RobotDescription, dt: f64, threshold: f64) -> Result<Self, LegKinematicsError> {
-        Ok(GroundDetector { estimator: TorqueEstimator::new(d, dt, DIGITAL_CUTOFF_HZ), legs: LegKinematics::hexapod_from_description(d)?, threshold })
+impl<L: GroundSensingLeg> GroundDetector<L> {
+    /// The detector of `robot` with the kinematics `legs` of its legs at the control period
+    /// `dt`, with the 3 Hz filters of Section 5.6.2 and the force `threshold` (N).
+    pub fn new(robot: &Robot, legs: [L; LEG_COUNT], dt: f64, threshold: f64) -> Self {
+        GroundDetector { estimator: TorqueEstimator::new(robot, dt, DIGITAL_CUTOFF_HZ), legs, threshold }
     }
 
     /// One control period: Eq. 5.14-5.16 and 5.22 for every leg from the measurements.
     pub fn update(&mut self, m: &Measurements) -> [LegDetection; LEG_COUNT] {
+        let linear_zones = self.estimator.linear_zones();
         let e = self.estimator.update(m);
-        std::array::from_fn(|leg| detect(&self.legs[leg], e, leg, self.threshold))
+        std::array::from_fn(|leg| detect(&self.legs[leg], e, leg, &linear_zones[leg], self.threshold))
     }
 
     /// The torques of the last update.
@@ -84,30 +142,23 @@ impl GroundDetector {
     /// before the first update or where J is singular.
     pub fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; LEG_COUNT]> {
         let e = self.estimator.estimate()?;
-        Some(std::array::from_fn(|leg| foot_force(&self.legs[leg], e, leg)))
+        Some(std::array::from_fn(|leg| Some(-(jacobian_inverse_transpose(&self.legs[leg], &leg_joints(e, leg))? * ground_torques(e, leg)))))
     }
 }
 
-/// F = −J^{−T} τ_gnd (Eq. 5.20, the force on the foot) from the estimated ground torques of `leg`.
-fn foot_force(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize) -> Option<Vector3<f64>> {
-    let k = 3 * leg;
-    let tau_gnd = Vector3::new(e.ground(k), e.ground(k + 1), e.ground(k + 2));
-    Some(-(jacobian_inverse_transpose(kinematics, &leg_joints(e, leg))? * tau_gnd))
-}
-
-fn detect(kinematics: &LegKinematics, e: &TorqueEstimate, leg: usize, threshold: f64) -> LegDetection {
-    let k = 3 * leg;
+fn detect<L: GroundSensingLeg>(leg_kinematics: &L, e: &TorqueEstimate, leg: usize, epsilon: &[f64; 3], threshold: f64) -> LegDetection {
     let q = leg_joints(e, leg);
-    let tau_v_gnd = e.ground(k + 1);
-    let force = alpha(kinematics, &q).map_or(0.0, |(a21, _)| a21 * tau_v_gnd);
-    let qd_v = e.qd[k + 1];
-    LegDetection { force, tau_v_gnd, qd_v, detected: force >= threshold && qd_v > 0.0 }
+    let qd = Vector3::new(e.qd[3 * leg], e.qd[3 * leg + 1], e.qd[3 * leg + 2]);
+    let force = leg_kinematics.vertical_ground_force(&q, &ground_torques(e, leg)).unwrap_or(0.0);
+    let lowering = leg_kinematics.lowering(&q, &qd);
+    LegDetection { force, lowering, sliding_lowering: leg_kinematics.sliding_lowering(&q, epsilon), detected: force >= threshold && lowering > 0.0 }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::description::RobotDescription;
+    use crate::physics::JointFriction;
     use crate::test_util::rng;
     use rand::Rng;
 
@@ -148,6 +199,70 @@ mod tests {
                 assert!((a21 * tau_gnd[1] - 50.0).abs() < 0.05 * 50.0, "leg at {q}: α21 τ_v = {}", a21 * tau_gnd[1]);
                 // Eq. B.2, z_foot ≈ −6 q_v: α_21 ≈ 1/6.
                 assert!((a21 * 6.0 - 1.0).abs() < 0.1, "α21 = {a21}");
+            }
+        }
+    }
+
+    /// A PhantomX leg (serial, AX-12A servos) lowering its foot straight down at 1 cm/s from
+    /// the middle of its joint ranges for 2 s (six time constants of the 3 Hz filters), the
+    /// currents of its three motors balancing a vertical ground force `f` and their friction:
+    /// the estimated foot force (vertical row and whole vector of −J^{−T} τ_gnd), against the
+    /// same leg in the air, is the oracle's force to 1 %. The oracle's Jacobian is the finite
+    /// difference of the leg's foot position; it leaves out the weight of the links.
+    #[test]
+    fn a_serial_leg_estimates_its_foot_force_on_its_own_jacobian() {
+        use crate::description::SHIPPED_ROBOTS;
+        use crate::hexapod::Leg;
+        use crate::robot::model::FrictionModel;
+        let (_, text, origin) = SHIPPED_ROBOTS[1];
+        let robot = Robot::from_str(text, origin).unwrap();
+        let Robot::Serial(serial) = &robot else { panic!("a serial robot") };
+        let legs = SerialLegKinematics::hexapod(&serial.hexapod.legs).unwrap();
+        let parts = robot.parts(&robot.model_options(FrictionModel::DryViscous));
+        let dt = robot.period();
+        let run = |f: f64| {
+            let mut detector = GroundDetector::new(&robot, legs.clone(), dt, 1.0);
+            let mut m = Measurements { supply_voltage: 12.0, ..Default::default() };
+            let mut q: [Vector3<f64>; 6] = std::array::from_fn(|l| legs[l].limits().middle());
+            let start: [Vector3<f64>; 6] = std::array::from_fn(|l| legs[l].foot(&q[l]));
+            let mut out = [LegDetection::default(); 6];
+            for n in 0..=(2.0 / dt).round() as usize {
+                for (l, leg) in legs.iter().enumerate() {
+                    let target = start[l] - Vector3::new(0.0, 0.0, 0.01 * n as f64 * dt);
+                    let next = Leg::inverse(leg, &target, &q[l]).unwrap();
+                    assert!(next.is_reached(), "leg {l} reaches {target}");
+                    let qd = (next.joints - q[l]) / dt;
+                    q[l] = next.joints;
+                    let h = 1e-7;
+                    let jacobian = Matrix3::from_fn(|i, j| {
+                        let (mut a, mut b) = (q[l], q[l]);
+                        a[j] += h;
+                        b[j] -= h;
+                        (leg.foot(&a)[i] - leg.foot(&b)[i]) / (2.0 * h)
+                    });
+                    let tau_gnd = -jacobian.transpose() * Vector3::new(0.0, 0.0, f);
+                    for j in 0..3 {
+                        let k = 3 * l + j;
+                        let JointFriction::DryViscous(law) = parts.friction[k].law else { unreachable!() };
+                        m.positions[k] = q[l][j];
+                        m.currents[k] = (tau_gnd[j] + law.torque(qd[j]).0) / (parts.motors[k].k_t * parts.motors[k].n);
+                    }
+                }
+                m.t = n as f64 * dt;
+                out = detector.update(&m);
+            }
+            (out, detector.foot_forces().unwrap().map(Option::unwrap))
+        };
+        let (air, air_forces) = run(0.0);
+        for f in [2.0, 8.0] {
+            let (loaded, forces) = run(f);
+            for l in 0..6 {
+                assert!((loaded[l].force - air[l].force - f).abs() < 0.01 * f, "leg {l}, F = {f} N: {} N, {} N in the air", loaded[l].force, air[l].force);
+                let force = forces[l] - air_forces[l];
+                assert!((force - Vector3::new(0.0, 0.0, f)).norm() < 0.01 * f, "leg {l}, F = {f} N: {force}");
+                // Lowered at 1 cm/s, every joint sliding.
+                assert!((loaded[l].lowering - 0.01).abs() < 1e-3 && loaded[l].lowering > loaded[l].sliding_lowering, "leg {l}: {:?}", loaded[l]);
+                assert!(loaded[l].detected);
             }
         }
     }

@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use super::ground_detection::{GroundDetector, LegDetection};
 use super::interface::{Command, Controller, Measurements};
 use super::{pi_command, DigitalPi};
-use crate::hexapod::{JOINTS, LEG_COUNT};
+use crate::hexapod::{LegKinematics, JOINTS, LEG_COUNT};
 
 /// Rest after each tested leg is put back on the ground (s).
 pub const REST_S: f64 = 1.0;
@@ -154,7 +154,7 @@ pub struct GroundExperimentController {
     pub pis: [DigitalPi; JOINTS],
     /// Joint positions held, and the stance q_v,0 of the tested legs.
     pub base: [f64; JOINTS],
-    pub detector: GroundDetector,
+    pub detector: GroundDetector<LegKinematics>,
     /// q_v where the tested leg stopped.
     hold: Option<f64>,
     state: Rc<RefCell<GroundExperimentState>>,
@@ -162,7 +162,7 @@ pub struct GroundExperimentController {
 
 impl GroundExperimentController {
     /// The controller and the state it publishes.
-    pub fn new(experiment: GroundExperiment, pis: [DigitalPi; JOINTS], base: [f64; JOINTS], detector: GroundDetector) -> (Self, Rc<RefCell<GroundExperimentState>>) {
+    pub fn new(experiment: GroundExperiment, pis: [DigitalPi; JOINTS], base: [f64; JOINTS], detector: GroundDetector<LegKinematics>) -> (Self, Rc<RefCell<GroundExperimentState>>) {
         let state = Rc::new(RefCell::new(GroundExperimentState::default()));
         (GroundExperimentController { experiment, pis, base, detector, hold: None, state: state.clone() }, state)
     }

@@ -17,7 +17,7 @@ mod torque_estimation;
 
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant};
 pub use joint_control::{joint_command, joint_pis, pi_command, JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
-pub use ground_detection::{alpha, GroundDetector, LegDetection};
+pub use ground_detection::{alpha, GroundDetector, GroundSensingLeg, LegDetection};
 pub use ground_experiment::{GroundExperiment, GroundExperimentController, GroundExperimentState, Stop, REST_S};
 pub use low_pass::{DigitalLowPass, DIGITAL_CUTOFF_HZ};
 pub use torque_estimation::{TorqueEstimate, TorqueEstimator};

@@ -17,13 +17,14 @@
 
 use super::interface::Measurements;
 use super::low_pass::DigitalLowPass;
-use crate::description::RobotDescription;
-use crate::hexapod::{joint_torques, PantographJoint, Mechanics, MechanicsParameters, StillBody, JOINTS};
+use crate::description::Robot;
+use crate::hexapod::{LegDynamics, StillBody, JOINTS, LEG_COUNT};
 use crate::mbs::Data;
-use crate::physics::DryViscous;
+use crate::physics::{DryViscous, JointFriction};
+use crate::robot::model::FrictionModel;
 
-/// The joint torques of one control instant (Nm for q_r, N for q_v and q_h), per joint
-/// k = 3 leg + (0: q_r, 1: q_v, 2: q_h).
+/// The joint torques of one control instant (Nm for a revolute joint, N for a prismatic one:
+/// q_r, and q_v, q_h on AMRU5), per joint k = 3 leg + j.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TorqueEstimate {
     /// Filtered positions q̂ and their backward differences q̂', q̂''.
@@ -48,7 +49,7 @@ impl TorqueEstimate {
 /// The torque estimator of Fig. 5.12 for the 18 joints.
 #[derive(Clone, Debug)]
 pub struct TorqueEstimator {
-    mechanics: Mechanics,
+    dynamics: LegDynamics,
     data: Data,
     friction: [DryViscous; JOINTS],
     /// n k_t per joint (Eq. 5.17).
@@ -60,23 +61,33 @@ pub struct TorqueEstimator {
 }
 
 impl TorqueEstimator {
-    /// The estimator of a robot description at the control period `dt` with the filter
-    /// cut-off `cutoff_hz` (3 Hz on AMRU5, [`super::DIGITAL_CUTOFF_HZ`]).
-    pub fn new(d: &RobotDescription, dt: f64, cutoff_hz: f64) -> Self {
-        let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
-        let data = Data::new(&mechanics.model);
-        // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters of Table 5.3.
-        let friction = std::array::from_fn(|k| d.friction(k / 3, PantographJoint::ALL[k % 3]).dry_viscous());
+    /// The estimator of a robot (either leg mechanism) at the control period `dt` with the
+    /// filter cut-off `cutoff_hz` (3 Hz on AMRU5, [`super::DIGITAL_CUTOFF_HZ`]).
+    pub fn new(robot: &Robot, dt: f64, cutoff_hz: f64) -> Self {
+        // Section 5.6.2: "a simple dry/viscous model", the unloaded parameters (Table 5.3 on
+        // AMRU5; a serial robot's drive friction).
+        let parts = robot.parts(&robot.model_options(FrictionModel::DryViscous));
+        let friction = std::array::from_fn(|k| match parts.friction[k].law {
+            JointFriction::DryViscous(law) => law,
+            _ => unreachable!("the parts of FrictionModel::DryViscous"),
+        });
+        let torque_per_ampere = std::array::from_fn(|k| parts.motors[k].k_t * parts.motors[k].n);
+        let dynamics = LegDynamics::from(parts);
         TorqueEstimator {
-            mechanics,
-            data,
+            data: Data::new(&dynamics.model),
+            dynamics,
             friction,
-            torque_per_ampere: std::array::from_fn(|k| d.joint_torque_per_ampere(PantographJoint::ALL[k % 3])),
+            torque_per_ampere,
             dt,
             positions: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
             currents: [DigitalLowPass::new(cutoff_hz, dt); JOINTS],
             estimate: None,
         }
+    }
+
+    /// The linear zone ε of each joint's dry/viscous law (Eq. 6.1), per leg.
+    pub fn linear_zones(&self) -> [[f64; 3]; LEG_COUNT] {
+        std::array::from_fn(|leg| std::array::from_fn(|j| self.friction[3 * leg + j].epsilon))
     }
 
     /// The estimate of the last update.
@@ -103,10 +114,10 @@ impl TorqueEstimator {
     }
 
     /// τ̂_iner + τ̂_grav added to τ̂_fric into `e.estimated`: Eq. 3.37 on the legs with the
-    /// body at rest ([`joint_torques`]), no foot force.
+    /// body at rest ([`LegDynamics::joint_torques`]), no foot force.
     fn inertia_and_gravity(&mut self, m: &Measurements, e: &mut TorqueEstimate) {
         let body = m.pose.map_or(StillBody::default(), |p| StillBody { pitch: p.pitch, roll: p.roll });
-        let tau = joint_torques(&self.mechanics, &mut self.data, body, &e.q, &e.qd, &e.qdd, None);
+        let tau = self.dynamics.joint_torques(&mut self.data, body, &e.q, &e.qd, &e.qdd, None);
         for k in 0..JOINTS {
             e.estimated[k] = tau[k] + e.friction[k];
         }

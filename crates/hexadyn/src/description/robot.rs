@@ -8,7 +8,7 @@ use super::serial::{SerialDescriptionFile, SerialRobot};
 use super::{PiGains, RobotDescription};
 use crate::fields::{Ctx, DescriptionError, Result, SpanIndex};
 use crate::control::FrictionFeedForward;
-use crate::hexapod::{LegJoints, PantographJoint, JOINTS};
+use crate::hexapod::{LegDynamics, LegJoints, PantographJoint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions, RobotParts};
 
 /// Where "missing field" errors of a serial description send the reader.
@@ -140,6 +140,12 @@ impl Robot {
             Robot::Pantograph(d) => RobotParts::from_description(d, options),
             Robot::Serial(s) => s.parts(options),
         }
+    }
+
+    /// The multibody model with its rotors and feet, for the joint torques on a still body
+    /// (the friction identification, the ground detection's torque estimate).
+    pub fn leg_dynamics(&self) -> LegDynamics {
+        self.parts(&self.model_options(FrictionModel::None)).into()
     }
 
     pub fn total_mass_kg(&self) -> f64 {

@@ -22,7 +22,7 @@ pub mod serial;
 pub mod workspace;
 
 pub use joints::{JointKind, JointNameError, LegJoints};
-pub use leg_dynamics::{joint_torques, leg_joint_torques, StillBody};
+pub use leg_dynamics::{LegDynamics, StillBody};
 pub use leg_kinematics::{Clamping, IkOptions, IkOutcome, IkSolution, JointLimits, Leg, LegChain, LegKinematics, LegKinematicsError, Limit, SerialLegKinematics, default_serial_height};
 pub use mechanics::{Inertia, LegBodies, Mechanics, MechanicsParameters};
 pub use pantograph::{PantographGeometry, PantographJoint};

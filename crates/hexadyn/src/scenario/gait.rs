@@ -18,7 +18,7 @@ use crate::control::gait::free::{FreeGaitController, FreeGaitOptions, LandingDet
 use crate::control::gait::heading::{Constant, Heading, HeadingSource, Segments, Series, Spline};
 use crate::control::gait::pattern::{FootCycle, GaitKind, GaitPattern};
 use crate::control::gait::schedule::{GaitChange, GaitState, PublishedFreeGait, ScheduledGait};
-use crate::control::{joint_pis, Controller, DigitalPi, FrictionFeedForward};
+use crate::control::{joint_pis, Controller, DigitalPi, FrictionFeedForward, GroundSensingLeg};
 use crate::hexapod::{default_serial_height, Leg, LegKinematics, LegKinematicsError, SerialLegKinematics, Workspace, JOINTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::Robot;
@@ -93,12 +93,12 @@ pub(super) struct RawGait {
 }
 
 /// How the free gait detects the landings (`gait.free.landing`). Without the field: the motor
-/// currents on the pantograph, the normal force on serial legs.
+/// currents on AMRU5's pantograph, the normal force on serial legs.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum LandingKind {
     /// The ground force estimated from the motor currents (Section 5.6.3), as on the real
-    /// robot: the pantograph's vertical joint only.
+    /// robot, on the leg's own Jacobian and dynamics.
     Current,
     /// The true normal force above a threshold: the simulation mode of Section 7.7.
     Force,
@@ -211,12 +211,12 @@ pub enum LandingSpec {
 }
 
 impl LandingSpec {
-    /// A fresh detector for a run of `robot` at the control period `dt` (s).
-    pub fn detector(&self, robot: &Robot, dt: f64) -> Box<dyn LandingDetector> {
-        match (*self, robot) {
-            (LandingSpec::Current { threshold }, Robot::Pantograph(d)) => Box::new(MotorCurrent::new(d, dt, threshold).expect("the scenario's validation built the legs of this robot")),
-            (LandingSpec::Current { .. }, Robot::Serial(_)) => unreachable!("the scenario's validation refuses landing = \"current\" on serial legs"),
-            (LandingSpec::Force { threshold }, _) => Box::new(NormalForce { threshold }),
+    /// A fresh detector for a run of `robot`, whose legs have the kinematics `legs`, at the
+    /// control period `dt` (s).
+    pub fn detector<L: GroundSensingLeg + Clone + Send + 'static>(&self, robot: &Robot, legs: &[L; 6], dt: f64) -> Box<dyn LandingDetector> {
+        match *self {
+            LandingSpec::Current { threshold } => Box::new(MotorCurrent::new(robot, legs.clone(), dt, threshold)),
+            LandingSpec::Force { threshold } => Box::new(NormalForce { threshold }),
         }
     }
 
@@ -286,8 +286,8 @@ impl GaitScenario {
     }
 
     /// The free gait on `legs`, publishing its state, with the master's friction feed-forward.
-    fn published<L: Leg + Clone + 'static>(&self, free: &FreeGaitSpec, legs: &[L; 6], pis: [DigitalPi; JOINTS], robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
-        let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, self.options.dt));
+    fn published<L: Leg + GroundSensingLeg + Clone + Send + 'static>(&self, free: &FreeGaitSpec, legs: &[L; 6], pis: [DigitalPi; JOINTS], robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
+        let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, legs, self.options.dt));
         let (c, state) = PublishedFreeGait::new(controller.with_friction_feedforward(self.friction_feedforward.clone()));
         (Box::new(c), state)
     }
@@ -364,7 +364,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, feedforward: Option<
             let stance = stance(g, c, &legs, default_body_height(&legs), " (the default, q_v = 0.06 m)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Current, THESIS_FORCE_THRESHOLD),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingDefaults::PANTOGRAPH),
                 Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
             .map(|w| w.on(GaitLegs::Pantograph(legs), stance))
@@ -374,7 +374,7 @@ pub(super) fn validate(g: &RawGait, c: &Ctx, robot: &Robot, feedforward: Option<
             let stance = stance(g, c, &legs, default_serial_height(&legs), " (the default: the feet with every joint at mid-range)", clearance)?;
             let heading = heading()?;
             match periodic {
-                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingKind::Force, weighted_force_threshold(robot)),
+                None => free_gait(g, c, heading, &legs, &stance, clearance, dt, LandingDefaults::weighted(robot)),
                 Some(p) => periodic_gait(g, c, p, heading, &legs, &stance, clearance, dt, duration),
             }
             .map(|w| w.on(GaitLegs::Serial(legs), stance))
@@ -528,22 +528,39 @@ pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
 /// mass move apart when the body pitches by 2° at the 0.41 m body height, plus the foot radius.
 pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 
-/// The default threshold of the normal-force landing on a robot other than AMRU5: Section 7.7's
-/// 10 N at the same share of the robot's weight as of AMRU5's. INTERPRETATION: 10 N is 3 % of
-/// AMRU5's weight; on the 1.8 kg PhantomX it would be 55 %, reached only once the leg carries
-/// half the body, and its free gait clamps its references and halts after 0.10 m.
-fn weighted_force_threshold(robot: &Robot) -> f64 {
-    THESIS_FORCE_THRESHOLD * robot.total_mass_kg() / crate::description::RobotDescription::amru5().total_mass_kg()
+/// The landing of a free gait without a `landing` field, and the default thresholds of each
+/// detection.
+#[derive(Clone, Copy, Debug)]
+struct LandingDefaults {
+    kind: LandingKind,
+    /// N, on the true normal force (Section 7.7's 10 N on AMRU5).
+    force: f64,
+    /// N, on the force estimated from the currents (Section 5.6.3's 40 N on AMRU5).
+    current: f64,
+}
+
+impl LandingDefaults {
+    /// AMRU5's pantograph: the motor currents, as on the real robot (Section 7.7).
+    const PANTOGRAPH: LandingDefaults = LandingDefaults { kind: LandingKind::Current, force: THESIS_FORCE_THRESHOLD, current: THESIS_CURRENT_THRESHOLD };
+
+    /// A robot other than AMRU5: the thresholds at the same share of the robot's weight as of
+    /// AMRU5's; the normal force unless the scenario asks for the currents.
+    ///
+    /// INTERPRETATION: 10 N is 3 % of AMRU5's weight; on the 1.8 kg PhantomX it would be 55 %,
+    /// reached only once the leg carries half the body, and its free gait clamps its references
+    /// and halts after 0.10 m. The currents' 40 N scale the same way (2.1 N on the PhantomX, a
+    /// fifth of a tripod leg's load as 40 N is of AMRU5's 100 N, Section 5.6.3).
+    fn weighted(robot: &Robot) -> LandingDefaults {
+        let weighted = |threshold: f64| threshold * robot.total_mass_kg() / crate::description::RobotDescription::amru5().total_mass_kg();
+        LandingDefaults { kind: LandingKind::Force, force: weighted(THESIS_FORCE_THRESHOLD), current: weighted(THESIS_CURRENT_THRESHOLD) }
+    }
 }
 
 /// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
-/// its workspace centre, a failed leg held up at the top of its workspace. `default_landing`:
-/// the landing detection without a `landing` field; serial legs (`LandingKind::Force`) refuse
-/// the motor currents, whose ground detection (Section 5.6.3) is the pantograph's.
-/// `force_threshold`: the default threshold of the normal-force landing (Section 7.7's 10 N on
-/// AMRU5).
+/// its workspace centre, a failed leg held up at the top of its workspace. `landing`: the
+/// landing detection without a `landing` field and the default thresholds.
 #[allow(clippy::too_many_arguments)]
-fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, default_landing: LandingKind, force_threshold: f64) -> Result<Walking> {
+fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, defaults: LandingDefaults) -> Result<Walking> {
     let Stance { height, workspaces, given } = *stance;
     let default = RawFree::default();
     let raw = g.free.as_ref().unwrap_or(&default);
@@ -555,16 +572,10 @@ fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], 
     let takeoff_time = positive("takeoff_s", raw.takeoff_s, DEFAULT_TAKEOFF_S)?;
     let swing_time = positive("swing_s", raw.swing_s, DEFAULT_SWING_S)?;
     let posture_time = positive("posture_time_s", raw.posture_time_s, DEFAULT_POSTURE_TIME_S)?;
-    let landing = match (raw.landing, default_landing) {
-        (None, default) => default,
-        (Some(LandingKind::Current), LandingKind::Force) => {
-            return Err(c.err("gait.free.landing", "\"current\"", "the ground detection from the motor currents (Section 5.6.3) needs the pantograph's vertical joint", "landing = \"force\" with serial legs (the true normal force above landing_threshold_n, default Section 7.7's 10 N scaled to the robot's weight), or no landing field"));
-        }
-        (Some(kind), _) => kind,
-    };
+    let landing = raw.landing.unwrap_or(defaults.kind);
     let (default_threshold, allowed) = match landing {
-        LandingKind::Current => (THESIS_CURRENT_THRESHOLD, "an estimated vertical ground force > 0 N with landing = \"current\" (default 40 N, the lowest threshold of Section 5.6.3)"),
-        LandingKind::Force => (force_threshold, "a normal force > 0 N with landing = \"force\" (default: Section 7.7's 10 N at the share of the robot's weight it is of AMRU5's)"),
+        LandingKind::Current => (defaults.current, "an estimated vertical ground force > 0 N with landing = \"current\" (default: Section 5.6.3's lowest threshold, 40 N on AMRU5, at the share of the robot's weight it is of AMRU5's)"),
+        LandingKind::Force => (defaults.force, "a normal force > 0 N with landing = \"force\" (default: Section 7.7's 10 N at the share of the robot's weight it is of AMRU5's)"),
     };
     let threshold = raw.landing_threshold_n.unwrap_or(default_threshold);
     c.check(threshold.is_finite() && threshold > 0.0, "gait.free.landing_threshold_n", threshold, allowed)?;

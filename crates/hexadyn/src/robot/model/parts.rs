@@ -8,7 +8,7 @@ use nalgebra::Vector3;
 use super::{FrictionModel, ModelOptions};
 use crate::control::{Encoder, PositionServo};
 use crate::description::{JointFrictionParameters, PiGains, RobotDescription};
-use crate::hexapod::{LegJoints, Mechanics, MechanicsParameters, PantographJoint, JOINTS};
+use crate::hexapod::{LegDynamics, LegJoints, Mechanics, MechanicsParameters, PantographJoint, JOINTS};
 use crate::mbs::{self, BodyId};
 use crate::physics::{DcMotor, FrictionElement, JointFriction, LuGre, SteadyState};
 
@@ -50,9 +50,10 @@ impl RobotParts {
             n: d.reduction(joint),
             inductance: options.inductance,
         };
+        let LegDynamics { model, feet } = mechanics.into();
         RobotParts {
-            feet: std::array::from_fn(|leg| (mechanics.legs[leg].links[3], mechanics.foot_local)),
-            multibody: mechanics.model,
+            multibody: model,
+            feet,
             joints: d.joints.names.clone(),
             motors: std::array::from_fn(|k| motor(PantographJoint::ALL[k % 3])),
             friction: std::array::from_fn(|k| friction_element(d, k / 3, PantographJoint::ALL[k % 3], options)),
@@ -64,6 +65,12 @@ impl RobotParts {
             encoders: std::array::from_fn(|k| Encoder { counts_per_rev: d.controller.encoder_impulses_per_rev, n: d.reduction(PantographJoint::ALL[k % 3]) }),
             servos: None,
         }
+    }
+}
+
+impl From<RobotParts> for LegDynamics {
+    fn from(p: RobotParts) -> Self {
+        LegDynamics { model: p.multibody, feet: p.feet }
     }
 }
 

@@ -9,9 +9,8 @@ use std::f64::consts::TAU;
 
 use nalgebra::Vector3;
 
-use crate::control::{GroundDetector, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
-use crate::description::RobotDescription;
-use crate::hexapod::{PantographJoint, LegKinematicsError};
+use crate::control::{GroundDetector, GroundSensingLeg, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
+use crate::description::Robot;
 
 /// Decides, at each control instant, which feet are on the ground, from the measurements. The
 /// free gait controller calls it once per update (so a detector may filter its signals over
@@ -55,24 +54,23 @@ impl LandingDetector for NormalForce {
 ///
 /// INTERPRETATION of "the joint velocity must be positive": the foot is being lowered, i.e.
 /// the vertical joint slides downwards (q̂_v' beyond the linear zone ε of its dry/viscous law,
-/// Eq. 6.1) and has done so for [`SETTLING_TIME_CONSTANTS`] time constants of the 3 Hz filters.
-/// Section 5.6.2 bases the estimate on the sliding friction ("low velocity behavior is not
-/// relevant in the obstacle detection, because leg is moving quite fast during the landing
-/// phase"): a still joint is held by its static friction, anywhere between the breakaway
-/// forces, which no dry/viscous model knows. In the simulated swing the vertical joint stands
-/// still under a PI current of up to 630 N (the LuGre joint creeps at 1e-5 m/s, inside ε),
-/// 100 N at the foot; when the landing starts, the filtered current still carries that force
-/// while the estimated friction turns to the sliding one, and the estimate crosses 40 N in the
-/// air for about 20 ms. Both transients are over once the joint has slid for a few filter time
-/// constants.
+/// Eq. 6.1; on other legs the foot descends with its joints sliding,
+/// [`GroundSensingLeg::sliding_lowering`]) and has done so for [`SETTLING_TIME_CONSTANTS`] time
+/// constants of the 3 Hz filters. Section 5.6.2 bases the estimate on the sliding friction
+/// ("low velocity behavior is not relevant in the obstacle detection, because leg is moving
+/// quite fast during the landing phase"): a still joint is held by its static friction,
+/// anywhere between the breakaway forces, which no dry/viscous model knows. In the simulated
+/// swing the vertical joint stands still under a PI current of up to 630 N (the LuGre joint
+/// creeps at 1e-5 m/s, inside ε), 100 N at the foot; when the landing starts, the filtered
+/// current still carries that force while the estimated friction turns to the sliding one, and
+/// the estimate crosses 40 N in the air for about 20 ms. Both transients are over once the
+/// joint has slid for a few filter time constants.
 #[derive(Clone, Debug)]
-pub struct MotorCurrent {
-    pub detector: GroundDetector,
+pub struct MotorCurrent<L> {
+    pub detector: GroundDetector<L>,
     /// The detector's output of the last update.
     pub detections: [LegDetection; 6],
-    /// ε of the dry/viscous law of each vertical joint (m/s).
-    epsilon: [f64; 6],
-    /// How long each vertical joint has been sliding down (s).
+    /// How long each foot has been lowered with its joints sliding (s).
     sliding: [f64; 6],
     /// Time the joint must have slid before a detection (s).
     settling: f64,
@@ -93,27 +91,26 @@ pub const THESIS_CURRENT_THRESHOLD: f64 = 40.0;
 /// the foot at the 4.5 cm/s of the landing).
 pub const SETTLING_TIME_CONSTANTS: f64 = 3.0;
 
-impl MotorCurrent {
-    /// The detector of a robot description at the control period `dt` (s) with the force
-    /// `threshold` (N).
-    pub fn new(d: &RobotDescription, dt: f64, threshold: f64) -> Result<Self, LegKinematicsError> {
-        Ok(MotorCurrent {
-            detector: GroundDetector::new(d, dt, threshold)?,
+impl<L: GroundSensingLeg> MotorCurrent<L> {
+    /// The detector of `robot` with the kinematics `legs` of its legs at the control period
+    /// `dt` (s) with the force `threshold` (N).
+    pub fn new(robot: &Robot, legs: [L; 6], dt: f64, threshold: f64) -> Self {
+        MotorCurrent {
+            detector: GroundDetector::new(robot, legs, dt, threshold),
             detections: Default::default(),
-            epsilon: std::array::from_fn(|l| d.friction(l, PantographJoint::Vertical).dry_viscous().epsilon),
             sliding: [0.0; 6],
             settling: SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ),
             dt,
-        })
+        }
     }
 }
 
-impl LandingDetector for MotorCurrent {
+impl<L: GroundSensingLeg + Send> LandingDetector for MotorCurrent<L> {
     fn ground_contact(&mut self, m: &Measurements) -> [bool; 6] {
         self.detections = self.detector.update(m);
         std::array::from_fn(|l| {
             let d = self.detections[l];
-            self.sliding[l] = if d.qd_v > self.epsilon[l] { self.sliding[l] + self.dt } else { 0.0 };
+            self.sliding[l] = if d.lowering > d.sliding_lowering { self.sliding[l] + self.dt } else { 0.0 };
             d.detected && self.sliding[l] >= self.settling - 0.5 * self.dt
         })
     }
@@ -126,12 +123,18 @@ impl LandingDetector for MotorCurrent {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hexapod::LegKinematics;
+    use crate::description::RobotDescription;
+    use crate::hexapod::{LegKinematics, PantographJoint};
+
+    /// AMRU5's detector from the currents at the threshold of the free gait.
+    fn amru5_detector(robot: &RobotDescription, dt: f64) -> MotorCurrent<LegKinematics> {
+        MotorCurrent::new(&Robot::Pantograph(robot.clone()), LegKinematics::hexapod_from_description(robot).unwrap(), dt, THESIS_CURRENT_THRESHOLD)
+    }
 
     /// The six legs going down from q_v = 0.05 m at `qd_v` (m/s) for `n` control periods with
     /// the motor current `current` (A) of their vertical joints, the other joints still and
     /// unpowered, the simulated foot forces `forces`. Returns the detections.
-    fn drive(d: &mut MotorCurrent, dt: f64, n: usize, qd_v: f64, current: f64, forces: Option<[f64; 6]>) -> Vec<[bool; 6]> {
+    fn drive(d: &mut MotorCurrent<LegKinematics>, dt: f64, n: usize, qd_v: f64, current: f64, forces: Option<[f64; 6]>) -> Vec<[bool; 6]> {
         let mut m = Measurements { supply_voltage: 12.0, foot_normal_forces: forces, ..Default::default() };
         (0..n)
             .map(|k| {
@@ -163,7 +166,7 @@ mod tests {
     /// current balancing `f`: the detections and the estimated force at the end.
     fn settled(robot: &RobotDescription, qd_v: f64, f: f64) -> (Vec<[bool; 6]>, f64) {
         let dt = robot.controller.period_s;
-        let mut d = MotorCurrent::new(robot, dt, THESIS_CURRENT_THRESHOLD).unwrap();
+        let mut d = amru5_detector(robot, dt);
         // q_v moves by 1 cm over the 2 s: the current is that of the middle.
         let i = balancing_current(robot, 0.055, qd_v, f);
         let out = drive(&mut d, dt, (2.0 / dt) as usize, qd_v, i, None);
@@ -200,7 +203,7 @@ mod tests {
         let dt = robot.controller.period_s;
         let i = balancing_current(&robot, 0.05, 0.0, 3.0 * THESIS_CURRENT_THRESHOLD);
         for creep in [0.0, 1e-5] {
-            let mut d = MotorCurrent::new(&robot, dt, THESIS_CURRENT_THRESHOLD).unwrap();
+            let mut d = amru5_detector(&robot, dt);
             assert!(drive(&mut d, dt, 300, creep, i, None).iter().flatten().all(|&c| !c), "creeping at {creep} m/s");
         }
         let (out, _) = settled(&robot, 0.005, 3.0 * THESIS_CURRENT_THRESHOLD);
@@ -213,7 +216,7 @@ mod tests {
     fn motor_current_ignores_the_simulated_foot_forces() {
         let robot = RobotDescription::amru5();
         let dt = robot.controller.period_s;
-        let mut d = MotorCurrent::new(&robot, dt, THESIS_CURRENT_THRESHOLD).unwrap();
+        let mut d = amru5_detector(&robot, dt);
         let i = balancing_current(&robot, 0.055, 0.005, 0.0);
         let out = drive(&mut d, dt, 200, 0.005, i, Some([500.0; 6]));
         assert!(out.iter().flatten().all(|&c| !c));
