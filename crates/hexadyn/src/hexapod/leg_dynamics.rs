@@ -35,8 +35,8 @@ impl From<Mechanics> for LegDynamics {
 }
 
 impl LegDynamics {
-    /// The generalized forces (Nm for a revolute joint, N for a prismatic one; joint k = 3 leg
-    /// + j) the motors must apply for the legs to follow (q, q', q'') = (`q`, `qd`, `qdd`) with
+    /// The generalized forces (Nm for a revolute joint, N for a prismatic one; joint
+    /// k = 3 leg + j) the motors must apply for the legs to follow (q, q', q'') = (`q`, `qd`, `qdd`) with
     /// the body at rest at the attitude `body` and the forces `foot_forces` (global frame, N) on
     /// the feet: the joint rows of the multibody residual M q̈ + h − g (Eq. 3.37, 3.38) without
     /// applied joint forces, i.e. τ_grav + τ_iner of Eq. 5.14. The rotors are part of the legs
