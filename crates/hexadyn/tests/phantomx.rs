@@ -128,11 +128,14 @@ fn the_shipped_walks_walk() {
 }
 
 /// The free gait of Section 7.7 on the PhantomX's serial legs over its rough ground
-/// (`phantomx_free_gait_rough`: 1 cm/s along +x for 150 s, navigation, landings from the normal
-/// force). It walks the commanded distance, its legs keep stepping, the body keeps its height
-/// and attitude over the ground, the feet meet the relief, no foot reference is clamped and the
-/// energy account closes. (With the thesis' 10 N landing threshold, 55 % of this robot's
-/// weight, the same run clamps 41 823 references and its body halts after 0.10 m: measured.)
+/// (`phantomx_free_gait_rough`: 1 cm/s along +x for 150 s, navigation, landings detected from
+/// the motor currents, Section 5.6.3 on the leg's own Jacobian and dynamics). It walks the
+/// commanded distance, its legs keep stepping, every landing is detected with the foot on the
+/// ground (its true normal force positive) and before it carries a tripod's share of the weight,
+/// the body keeps its height and attitude over the ground, the feet meet the relief, no foot
+/// reference is clamped and the energy account closes. (With the normal-force landing at the
+/// thesis' 10 N, 55 % of this robot's weight, the same run clamps 41 823 references and its body
+/// halts after 0.10 m: measured.)
 #[test]
 fn the_free_gait_walks_over_rough_ground() {
     let s = Scenario::from_file(root().join("python/hexadyn/scenarios/phantomx_free_gait_rough.toml")).unwrap();
@@ -167,6 +170,11 @@ fn the_free_gait_walks_over_rough_ground() {
         assert!(gap < longest_gap, "leg {l}: {gap:.1} s without a landing (at most {longest_gap:.1} s): {times:?}");
         landings += touchdowns.len();
         heights.extend(touchdowns.iter().map(|&k| column(&format!("foot_z[{l}]"))[k]));
+        let weight = s.robot.total_mass_kg() * hexadyn::mbs::STANDARD_GRAVITY;
+        for &k in &touchdowns {
+            let fn_true = column(&format!("Fn[{l}]"))[k];
+            assert!(fn_true > 0.0 && fn_true < weight / 2.0, "leg {l} at t = {} s: landing detected with a normal force of {fn_true} N", t[k]);
+        }
     }
     let mean = heights.iter().sum::<f64>() / heights.len() as f64;
     let spread = (heights.iter().map(|z| (z - mean).powi(2)).sum::<f64>() / heights.len() as f64).sqrt();

@@ -452,17 +452,18 @@ fn walking_scenarios_parse() {
     assert_eq!(landing(&with("free_gait_slope_square", "landing_threshold_n = 10.0\n", "")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_straight", "landing = \"current\"", "landing = \"force\"").replace("landing_threshold_n = 40.0", "")), LandingSpec::Force { threshold: 10.0 });
     assert_eq!(landing(&with("free_gait_slope_square", "landing = \"force\"\nlanding_threshold_n = 10.0\n", "")), LandingSpec::Current { threshold: 40.0 });
-    // On serial legs the normal force, also without the field (the currents' detection of
-    // Section 5.6.3 is the pantograph's).
+    // On serial legs the same detections, at the thesis' thresholds scaled from AMRU5's weight
+    // to the robot's (2.14 N and 0.54 N on the PhantomX).
     let px = "phantomx_free_gait_rough";
     let terrain = format!("file = \"{}/terrains/", scenarios_dir().display());
     let px_with = |from: &str, to: &str| with(px, from, to).replace("file = \"terrains/", &terrain);
-    // At Section 7.7's 10 N scaled from AMRU5's weight to the robot's (0.54 N on the PhantomX).
-    let scaled = 10.0 * Robot::from_str(hexadyn::description::PHANTOMX_TOML, "phantomx").unwrap().total_mass_kg() / Robot::from_str(AMRU5_TOML, "amru5").unwrap().total_mass_kg();
-    assert!((scaled - 0.535).abs() < 0.001, "{scaled}");
-    assert_eq!(landing(&px_with("", "")), LandingSpec::Force { threshold: scaled });
-    assert_eq!(landing(&px_with("landing = \"force\"", "")), LandingSpec::Force { threshold: scaled });
-    assert_eq!(landing(&px_with("landing = \"force\"", "landing_threshold_n = 10.0")), LandingSpec::Force { threshold: 10.0 });
+    let (m, m_amru5) = (Robot::from_str(hexadyn::description::PHANTOMX_TOML, "phantomx").unwrap().total_mass_kg(), Robot::from_str(AMRU5_TOML, "amru5").unwrap().total_mass_kg());
+    let (current, force) = (40.0 * m / m_amru5, 10.0 * m / m_amru5);
+    assert!((current - 2.14).abs() < 0.005 && (force - 0.535).abs() < 0.001, "{current} {force}");
+    assert_eq!(landing(&px_with("", "")), LandingSpec::Current { threshold: current });
+    assert_eq!(landing(&px_with("landing = \"current\"", "")), LandingSpec::Current { threshold: current });
+    assert_eq!(landing(&px_with("landing = \"current\"", "landing = \"force\"")), LandingSpec::Force { threshold: force });
+    assert_eq!(landing(&px_with("landing = \"current\"", "landing = \"force\"\nlanding_threshold_n = 10.0")), LandingSpec::Force { threshold: 10.0 });
 
     // Waypoints of a spline.
     let text = with("path_spline", "kind = \"spline\"", "kind = \"spline\"\nt_s = [0.0, 50.0, 100.0]\nx_m = [0.0, 0.5, 1.0]\ny_m = [0.0, 0.2, 0.0]");
@@ -544,12 +545,12 @@ fn gait_errors_name_the_field() {
     let s = field_error(&with(v, "mode = \"gait\"", "mode = \"gait\"\n[[control.motion]]\nleg = 0\njoint = \"q_v\"\nkind = \"sine\"\namplitude = 0.001\nfrequency_hz = 1.0"), "control.motion");
     assert!(s.contains("mode = \"pi\""), "{s}");
 
-    // The free gait on serial legs: the landing from the motor currents is the pantograph's.
-    let px = "phantomx_free_gait_rough";
-    let text = with(px, "landing = \"force\"", "landing = \"current\"").replace("file = \"terrains/", &format!("file = \"{}/terrains/", scenarios_dir().display()));
-    let s = field_error(&text, "gait.free.landing");
-    assert!(s.contains("\"current\"") && s.contains("landing = \"force\"") && s.contains("serial"), "{s}");
-    let line = shipped(px).lines().position(|l| l.starts_with("landing =")).unwrap() + 1;
+    // The experiment of Section 5.6.3 lowers the pantograph's vertical joint: refused on serial
+    // legs, on the line of the mode.
+    let px = "phantomx_stand";
+    let s = field_error(&with(px, "mode = \"pi\"", "mode = \"ground_detection\"\n[ground_detection]\nlegs = [0]\n#"), "control.mode");
+    assert!(s.contains("\"ground_detection\"") && s.contains("serial"), "{s}");
+    let line = shipped(px).lines().position(|l| l.starts_with("mode =")).unwrap() + 1;
     assert!(s.starts_with(&format!("bad.toml:{line}:")), "{s}");
 }
 

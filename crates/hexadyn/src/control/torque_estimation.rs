@@ -18,7 +18,7 @@
 use super::interface::Measurements;
 use super::low_pass::DigitalLowPass;
 use crate::description::Robot;
-use crate::hexapod::{LegDynamics, StillBody, JOINTS, LEG_COUNT};
+use crate::hexapod::{LegDynamics, StillBody, JOINTS};
 use crate::mbs::Data;
 use crate::physics::{DryViscous, JointFriction};
 use crate::robot::model::FrictionModel;
@@ -85,9 +85,9 @@ impl TorqueEstimator {
         }
     }
 
-    /// The linear zone ε of each joint's dry/viscous law (Eq. 6.1), per leg.
-    pub fn linear_zones(&self) -> [[f64; 3]; LEG_COUNT] {
-        std::array::from_fn(|leg| std::array::from_fn(|j| self.friction[3 * leg + j].epsilon))
+    /// The dry/viscous law of each joint (Eq. 6.1), k = 3 leg + j.
+    pub fn dry_viscous(&self) -> [DryViscous; JOINTS] {
+        self.friction
     }
 
     /// The estimate of the last update.

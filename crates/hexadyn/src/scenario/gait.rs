@@ -93,7 +93,7 @@ pub(super) struct RawGait {
 }
 
 /// How the free gait detects the landings (`gait.free.landing`). Without the field: the motor
-/// currents on AMRU5's pantograph, the normal force on serial legs.
+/// currents, as on the real robot.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum LandingKind {
@@ -528,11 +528,9 @@ pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
 /// mass move apart when the body pitches by 2° at the 0.41 m body height, plus the foot radius.
 pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
 
-/// The landing of a free gait without a `landing` field, and the default thresholds of each
-/// detection.
+/// The default thresholds of each landing detection of a free gait.
 #[derive(Clone, Copy, Debug)]
 struct LandingDefaults {
-    kind: LandingKind,
     /// N, on the true normal force (Section 7.7's 10 N on AMRU5).
     force: f64,
     /// N, on the force estimated from the currents (Section 5.6.3's 40 N on AMRU5).
@@ -540,25 +538,26 @@ struct LandingDefaults {
 }
 
 impl LandingDefaults {
-    /// AMRU5's pantograph: the motor currents, as on the real robot (Section 7.7).
-    const PANTOGRAPH: LandingDefaults = LandingDefaults { kind: LandingKind::Current, force: THESIS_FORCE_THRESHOLD, current: THESIS_CURRENT_THRESHOLD };
+    /// AMRU5's pantograph: the thesis' thresholds.
+    const PANTOGRAPH: LandingDefaults = LandingDefaults { force: THESIS_FORCE_THRESHOLD, current: THESIS_CURRENT_THRESHOLD };
 
     /// A robot other than AMRU5: the thresholds at the same share of the robot's weight as of
-    /// AMRU5's; the normal force unless the scenario asks for the currents.
+    /// AMRU5's.
     ///
     /// INTERPRETATION: 10 N is 3 % of AMRU5's weight; on the 1.8 kg PhantomX it would be 55 %,
     /// reached only once the leg carries half the body, and its free gait clamps its references
     /// and halts after 0.10 m. The currents' 40 N scale the same way (2.1 N on the PhantomX, a
-    /// fifth of a tripod leg's load as 40 N is of AMRU5's 100 N, Section 5.6.3).
+    /// third of a tripod leg's 6 N load; AMRU5's 40 N is 40 % of its 100 N, Section 5.6.3).
     fn weighted(robot: &Robot) -> LandingDefaults {
         let weighted = |threshold: f64| threshold * robot.total_mass_kg() / crate::description::RobotDescription::amru5().total_mass_kg();
-        LandingDefaults { kind: LandingKind::Force, force: weighted(THESIS_FORCE_THRESHOLD), current: weighted(THESIS_CURRENT_THRESHOLD) }
+        LandingDefaults { force: weighted(THESIS_FORCE_THRESHOLD), current: weighted(THESIS_CURRENT_THRESHOLD) }
     }
 }
 
 /// The free gait (`pattern = "free"`, `[gait.free]`): every working foot starts on the ground at
-/// its workspace centre, a failed leg held up at the top of its workspace. `landing`: the
-/// landing detection without a `landing` field and the default thresholds.
+/// its workspace centre, a failed leg held up at the top of its workspace. Without a `landing`
+/// field the landings are detected from the motor currents, as on the real robot (Section 7.7);
+/// `defaults`: the thresholds without a `landing_threshold_n`.
 #[allow(clippy::too_many_arguments)]
 fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], stance: &Stance, lift: f64, dt: f64, defaults: LandingDefaults) -> Result<Walking> {
     let Stance { height, workspaces, given } = *stance;
@@ -572,7 +571,7 @@ fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], 
     let takeoff_time = positive("takeoff_s", raw.takeoff_s, DEFAULT_TAKEOFF_S)?;
     let swing_time = positive("swing_s", raw.swing_s, DEFAULT_SWING_S)?;
     let posture_time = positive("posture_time_s", raw.posture_time_s, DEFAULT_POSTURE_TIME_S)?;
-    let landing = raw.landing.unwrap_or(defaults.kind);
+    let landing = raw.landing.unwrap_or(LandingKind::Current);
     let (default_threshold, allowed) = match landing {
         LandingKind::Current => (defaults.current, "an estimated vertical ground force > 0 N with landing = \"current\" (default: Section 5.6.3's lowest threshold, 40 N on AMRU5, at the share of the robot's weight it is of AMRU5's)"),
         LandingKind::Force => (defaults.force, "a normal force > 0 N with landing = \"force\" (default: Section 7.7's 10 N at the share of the robot's weight it is of AMRU5's)"),
@@ -588,7 +587,8 @@ fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], 
     };
     let stability_margin = raw.stability_margin_m.unwrap_or(DEFAULT_STABILITY_MARGIN_M);
     c.check(stability_margin.is_finite() && stability_margin >= 0.0, "gait.free.stability_margin_m", stability_margin, "a distance >= 0 m")?;
-    let elevator = raw.elevator.unwrap_or(true);
+    // The elevator reflex reads the same estimator as the landing, at the same threshold.
+    let elevator = raw.elevator.unwrap_or(true).then_some(threshold);
     let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, dt, elevator };
     let footholds: [Vector3<f64>; 6] = std::array::from_fn(|l| {
         let w = &workspaces[l];

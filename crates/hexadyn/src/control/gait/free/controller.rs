@@ -12,7 +12,7 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use super::elevator::{resistance, retreat, ELEVATOR_FORCE};
+use super::elevator::{resistance, retreat};
 use super::landing::SETTLING_TIME_CONSTANTS;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
@@ -66,9 +66,10 @@ pub struct FreeGaitOptions {
     pub stability_margin: f64,
     /// Control period Δt (s).
     pub dt: f64,
-    /// The elevator reflex of the swing ([`super::elevator`], beyond the thesis): a swinging
-    /// foot stopped by an obstacle rises by the lift and goes on.
-    pub elevator: bool,
+    /// The elevator reflex of the swing ([`super::elevator`], beyond the thesis) with its
+    /// threshold (N) on the estimated force resisting the swing, or None: a swinging foot
+    /// stopped by an obstacle rises by the lift and goes on.
+    pub elevator: Option<f64>,
 }
 
 /// The state of one leg.
@@ -543,11 +544,11 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                     FootPhase::Swing => {
                         let aep = self.aep(l, &v_c, leg.pep.z);
                         let pushed = forces.and_then(|f| f[l]).map_or(0.0, |f| resistance(&f, &(aep - leg.pep)));
-                        leg.resisted = if pushed > ELEVATOR_FORCE && leg.elapsed >= settling - 0.5 * o.dt { leg.resisted + o.dt } else { 0.0 };
+                        leg.resisted = if o.elevator.is_some_and(|threshold| pushed > threshold) && leg.elapsed >= settling - 0.5 * o.dt { leg.resisted + o.dt } else { 0.0 };
                         let settled = leg.resisted >= settling - 0.5 * o.dt;
                         let measured = self.legs_kinematics[l].foot(&joints_of(m, l));
                         let back = retreat(&leg.foot, &measured, &(aep - leg.pep));
-                        if o.elevator && settled && self.reaches(l, &(back + Vector3::z() * (0.5 * o.lift)), &leg.joints) {
+                        if settled && self.reaches(l, &(back + Vector3::z() * (0.5 * o.lift)), &leg.joints) {
                             // An obstacle: back off and rise (super::elevator) in the swing
                             // time that is left.
                             leg.swing_time = (leg.swing_time - leg.elapsed).max(o.takeoff_time);
@@ -562,6 +563,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                                 // The landing: a virtual anchor where the foot is, so that the
                                 // support algorithm runs while the foot descends (Section 7.6).
                                 (leg.phase, leg.elapsed, leg.descent) = (FootPhase::Landing, 0.0, 0.0);
+                                self.landing.landing_starts(l);
                                 leg.anchor = self.leg_frame(l, &estimated).apply(&p);
                             }
                             p

@@ -15,7 +15,9 @@
 //! reference, and a long swing lags its reference by centimetres on flat ground.)
 //!
 //! INTERPRETATION (the thesis is silent): the resistance is the estimated foot force against the
-//! horizontal swing direction; when it stays above [`ELEVATOR_FORCE`] for the settling time of
+//! horizontal swing direction; when it stays above the threshold of the landing detection
+//! (`gait.free.landing_threshold_n`, 40 N on AMRU5, the same estimator on the joints that drive
+//! the swing) for the settling time of
 //! the 3 Hz filters ([`SETTLING_TIME_CONSTANTS`], counted once the joints have swung for that
 //! time: the reversal of the joints at the start of the swing reads as up to 65 N for about
 //! 0.15 s on flat ground, a riser pushes as long as the swing goes on), the foot backs off by
@@ -28,16 +30,8 @@
 
 use nalgebra::Vector3;
 
-use super::landing::THESIS_CURRENT_THRESHOLD;
 #[cfg(doc)]
 use super::landing::SETTLING_TIME_CONSTANTS;
-
-/// Estimated force (N) resisting the swing that reads as an obstacle.
-///
-/// INTERPRETATION: the threshold of the landing detection from the currents
-/// ([`THESIS_CURRENT_THRESHOLD`], 40 N, the lowest that Section 5.6.3 validated above the
-/// transmissions' disturbances); the same estimator, on the joints that drive the swing.
-pub const ELEVATOR_FORCE: f64 = THESIS_CURRENT_THRESHOLD;
 
 /// How far the foot backs off from the obstacle before it rises (m): the foot radius of AMRU5
 /// (2 cm), so that the foot does not rub up the riser face under the PI's push.

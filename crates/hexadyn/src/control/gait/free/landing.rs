@@ -24,6 +24,10 @@ pub trait LandingDetector: Send {
     fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; 6]> {
         None
     }
+
+    /// `leg` starts its landing: a detector that waits for the signals to follow the motion
+    /// starts waiting from here.
+    fn landing_starts(&mut self, _leg: usize) {}
 }
 
 /// The simulation mode of Section 7.7: the ground is detected when the true normal force on the
@@ -54,23 +58,28 @@ impl LandingDetector for NormalForce {
 ///
 /// INTERPRETATION of "the joint velocity must be positive": the foot is being lowered, i.e.
 /// the vertical joint slides downwards (q̂_v' beyond the linear zone ε of its dry/viscous law,
-/// Eq. 6.1; on other legs the foot descends with its joints sliding,
-/// [`GroundSensingLeg::sliding_lowering`]) and has done so for [`SETTLING_TIME_CONSTANTS`] time
-/// constants of the 3 Hz filters. Section 5.6.2 bases the estimate on the sliding friction
-/// ("low velocity behavior is not relevant in the obstacle detection, because leg is moving
-/// quite fast during the landing phase"): a still joint is held by its static friction,
-/// anywhere between the breakaway forces, which no dry/viscous model knows. In the simulated
-/// swing the vertical joint stands still under a PI current of up to 630 N (the LuGre joint
-/// creeps at 1e-5 m/s, inside ε), 100 N at the foot; when the landing starts, the filtered
-/// current still carries that force while the estimated friction turns to the sliding one, and
-/// the estimate crosses 40 N in the air for about 20 ms. Both transients are over once the
-/// joint has slid for a few filter time constants.
+/// Eq. 6.1), and has done so for [`SETTLING_TIME_CONSTANTS`] time constants of the 3 Hz
+/// filters, from the start of the landing. On other legs: the foot goes down while every
+/// joint that carries the vertical force ([`crate::control::ground_detection::CARRYING_SHARE`])
+/// slides. Section 5.6.2 bases the estimate on the sliding friction ("low velocity behavior is
+/// not relevant in the obstacle detection, because leg is moving quite fast during the landing
+/// phase"): a still joint is held by its static friction, anywhere between the breakaway
+/// forces, which no dry/viscous model knows. In the simulated swing the vertical joint stands
+/// still under a PI current of up to 630 N (the LuGre joint creeps at 1e-5 m/s, inside ε),
+/// 100 N at the foot; when the landing starts, the filtered current still carries that force
+/// while the estimated friction turns to the sliding one, and the estimate crosses 40 N in the
+/// air for about 20 ms. Both transients are over once the joint has slid for a few filter time
+/// constants. A serial leg's femur and tibia slide through the swing, its foot often sinking
+/// slowly with the body, and turn at the landing: the estimated friction flips with them at
+/// once, the filtered current later (measured on the PhantomX: 4.9 N in the air against a 2.1 N
+/// threshold at the first instant of a landing); hence the wait counts from the landing's
+/// start ([`LandingDetector::landing_starts`]).
 #[derive(Clone, Debug)]
 pub struct MotorCurrent<L> {
     pub detector: GroundDetector<L>,
     /// The detector's output of the last update.
     pub detections: [LegDetection; 6],
-    /// How long each foot has been lowered with its joints sliding (s).
+    /// How long each foot has been lowered with its joints sliding in its landing (s).
     sliding: [f64; 6],
     /// Time the joint must have slid before a detection (s).
     settling: f64,
@@ -110,13 +119,17 @@ impl<L: GroundSensingLeg + Send> LandingDetector for MotorCurrent<L> {
         self.detections = self.detector.update(m);
         std::array::from_fn(|l| {
             let d = self.detections[l];
-            self.sliding[l] = if d.lowering > d.sliding_lowering { self.sliding[l] + self.dt } else { 0.0 };
+            self.sliding[l] = if d.sliding && d.lowering > 0.0 { self.sliding[l] + self.dt } else { 0.0 };
             d.detected && self.sliding[l] >= self.settling - 0.5 * self.dt
         })
     }
 
     fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; 6]> {
         self.detector.foot_forces()
+    }
+
+    fn landing_starts(&mut self, leg: usize) {
+        self.sliding[leg] = 0.0;
     }
 }
 

@@ -29,7 +29,7 @@ fn setup() -> Setup {
 }
 
 fn options(s: &Setup, dt: f64, failed_leg: Option<usize>) -> FreeGaitOptions {
-    FreeGaitOptions { body_height: s.height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg, stability_margin: 0.02, dt, elevator: true }
+    FreeGaitOptions { body_height: s.height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg, stability_margin: 0.02, dt, elevator: Some(THESIS_CURRENT_THRESHOLD) }
 }
 
 /// The ideal plant: joints = references, the body where the controller wants it, a foot on the
