@@ -2,8 +2,9 @@
 
 The experiments are shipped scenarios (``identification_q_r``, ``_q_v``, ``_q_h``: the sawtooth
 campaigns of Table 5.2; ``identification_breakaway_plus``/``_minus``: Section 5.3;
-``identification_loaded_q_h``: Section 5.4). :func:`identify` reads their results folders, or
-CSV logs of a real robot (:mod:`hexadyn.identify.logs`), and fits the friction parameters with
+``identification_loaded_q_h``: Section 5.4; on the PhantomX's serial legs the sawtooth campaigns
+``phantomx_identification_coxa``, ``_femur``, ``_tibia``). :func:`identify` reads their results
+folders, or CSV logs of a real robot (:mod:`hexadyn.identify.logs`), and fits the friction parameters with
 their confidence intervals; :func:`hexadyn.identify.output.save` writes the tables of Tables
 5.3-5.5, the figures of Fig. 5.3-5.5, the ``[model.joint_friction]`` fragment and the friction
 statistics of the Monte Carlo runs. ``hexadyn identify`` is the command line

@@ -38,10 +38,11 @@ class BreakawayOptions:
 
 @dataclass(frozen=True)
 class Breakaway:
-    """One breakaway measurement: tau_f,s (NaN when not identified, then `reason` says why), its
-    direction (the voltage's), the instant and the foot load."""
+    """One breakaway measurement of a joint: tau_f,s (NaN when not identified, then `reason` says
+    why), its direction (the voltage's), the instant and the foot load."""
 
     source: str
+    joint: str
     leg: int
     direction: int
     load_kg: float
@@ -74,7 +75,7 @@ def breakaway(log: Log, leg: int, options: BreakawayOptions, joint: str = "q_v")
     direction = int(np.sign(log.frame[voltage].iloc[-1])) if voltage in log.frame and log.frame[voltage].iloc[-1] != 0 else moved
     if k < length or moved != direction:
         why = "from the start" if k < length else "against the voltage"
-        return Breakaway(log.source, leg, direction, log.foot_load_kg[leg], float("nan"), float(t[k]), f"reversible: moves {why} (t = {t[k]:.2f} s)")
+        return Breakaway(log.source, joint, leg, direction, log.foot_load_kg[leg], float("nan"), float(t[k]), f"reversible: moves {why} (t = {t[k]:.2f} s)")
     tau = signal.savgol_filter(friction_torque(log, joint, leg, slice(0, k + 1)), length, 1, mode="interp")
     tau_f_s = float(tau.max() if direction > 0 else tau.min())
-    return Breakaway(log.source, leg, direction, log.foot_load_kg[leg], tau_f_s, float(t[k]))
+    return Breakaway(log.source, joint, leg, direction, log.foot_load_kg[leg], tau_f_s, float(t[k]))

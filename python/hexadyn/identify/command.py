@@ -11,16 +11,17 @@ __all__ = ["identify_command"]
 
 @click.command("identify")
 @click.argument("logs", nargs=-1, required=True, type=click.Path(exists=True, path_type=Path))
-@click.option("--joint", type=click.Choice(["q_r", "q_v", "q_h"]), default=None, help="Identify only this joint type (default: every joint the logs exercise).")
+@click.option("--joint", default=None, help="Identify only this joint of the logs' robot (q_r, q_v or q_h on AMRU5; coxa, femur or tibia on the PhantomX; default: every joint the logs exercise).")
 @click.option("--out", "-o", type=click.Path(path_type=Path), required=True, help="Folder to write (tables, figures, joint_friction.toml, friction_stats.toml).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing --out folder.")
-@click.option("--robot", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Robot description of CSV logs (default: the embedded AMRU5).")
+@click.option("--robot", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Robot description file of CSV logs, e.g. robots/phantomx/phantomx.toml (default: the embedded AMRU5); a results folder carries its own.")
 @click.option("--transient", "transient_s", type=click.FloatRange(min=0.0), default=1.5, show_default=True, help="Seconds dropped after each reversal (velocity transient).")
 @click.option("--format", "formats", default="png", show_default=True, help="Figure formats, comma-separated (png, pdf, svg).")
 def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overwrite: bool, robot: Path | None, transient_s: float, formats: str) -> None:
     """Identify joint friction from LOGS: results folders of the identification scenarios
     (identification_q_r, _q_v, _q_h, identification_breakaway_plus/_minus,
-    identification_loaded_q_h) or CSV logs of a real robot. Each log is one campaign; several
+    identification_loaded_q_h; phantomx_identification_coxa, _femur, _tibia) or CSV logs of a
+    real robot. Each log is one campaign; several
     campaigns give the mean and standard deviation of Tables 5.3-5.5."""
     from tqdm.auto import tqdm
 

@@ -1,7 +1,9 @@
 """The friction/velocity curves of Fig. 5.3-5.5: per joint type, the mean friction torque of
 every constant-velocity section against its velocity, one colour per leg, with the fitted
 dry/viscous lines; (a) negative velocities, (b) positive ones, as in the thesis. Loaded logs
-(Section 5.4) get one figure per load; the Eq. 5.12 fits their own (Fig. 5.10).
+(Section 5.4) get one figure per load; the Eq. 5.12 fits their own (Fig. 5.10). AMRU5's joints
+are drawn as the thesis' figures (``figure_5_4_q_v``); another robot's joints in the same
+layout, named after the joint (``figure_friction_femur``).
 """
 
 from __future__ import annotations
@@ -14,20 +16,26 @@ from hexadyn.identify.logs import LEGS
 from hexadyn.identify.tables import UNITS
 from hexadyn.plots import style
 
-__all__ = ["friction_figure", "load_figure", "figures", "FIGURE_NUMBERS"]
+__all__ = ["friction_figure", "load_figure", "figures", "figure_stem", "FIGURE_NUMBERS"]
 
-#: The thesis figure of each joint type.
+#: The thesis figure of each AMRU5 joint type.
 FIGURE_NUMBERS = {"q_r": "5_3", "q_v": "5_4", "q_h": "5_5"}
 _NAMES = {"q_r": "rotational", "q_v": "vertical", "q_h": "horizontal"}
-#: Display scale of the velocities: deg/s for q_r, mm/s for q_v and q_h (Table 5.2).
-_SPEED = {"q_r": (180 / np.pi, "deg/s"), "q_v": (1e3, "mm/s"), "q_h": (1e3, "mm/s")}
+#: Display scale of the velocities per joint kind: deg/s for q_r, mm/s for q_v and q_h (Table 5.2).
+_SPEED = {"revolute": (180 / np.pi, "deg/s"), "prismatic": (1e3, "mm/s")}
+
+
+def figure_stem(joint: str) -> str:
+    """File stem of the friction figure of `joint` (unloaded legs)."""
+    return f"figure_{FIGURE_NUMBERS[joint]}_{joint}" if joint in FIGURE_NUMBERS else f"figure_friction_{joint}"
 
 
 def friction_figure(ident: Identification, joint: str, load_kg: float = 0.0) -> Figure:
     """Fig. 5.3 (q_r), 5.4 (q_v) or 5.5 (q_h): friction against velocity with the fitted lines.
     The lines are drawn in joint units per second of the fit (f_v in Nm s/rad or N s/m)."""
-    scale, speed_unit = _SPEED[joint]
-    dry_unit = UNITS[joint][0]
+    kind = ident.kinds[joint]
+    scale, speed_unit = _SPEED[kind]
+    dry_unit = UNITS[kind][0]
     with style():
         fig = Figure(figsize=(6.5, 2.8))
         axes = fig.subplots(1, 2, sharey=False)
@@ -52,7 +60,7 @@ def friction_figure(ident: Identification, joint: str, load_kg: float = 0.0) -> 
         if handles:
             fig.legend(handles, labels, loc="outside right center")
         load = "" if load_kg == 0 else f", {load_kg:g} kg at the foot"
-        fig.suptitle(f"Friction model for {_NAMES[joint]} joints ({'unloaded legs' if load_kg == 0 else 'loaded legs'}{load})")
+        fig.suptitle(f"Friction model for {_NAMES.get(joint, joint)} joints ({'unloaded legs' if load_kg == 0 else 'loaded legs'}{load})")
     return fig
 
 
@@ -80,9 +88,9 @@ def load_figure(ident: Identification) -> Figure:
 def figures(ident: Identification) -> dict[str, Figure]:
     """Every figure of an identification, by file stem."""
     out = {}
-    for joint in ("q_r", "q_v", "q_h"):
+    for joint in ident.kinds:
         for load in sorted({p.load_kg for p in ident.points if p.joint == joint}):
-            stem = f"figure_{FIGURE_NUMBERS[joint]}_{joint}" + ("" if load == 0 else f"_{load:g}kg")
+            stem = figure_stem(joint) + ("" if load == 0 else f"_{load:g}kg")
             out[stem] = friction_figure(ident, joint, load)
     if ident.load_fits:
         out["figure_5_10_q_h_load"] = load_figure(ident)

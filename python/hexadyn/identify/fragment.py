@@ -8,6 +8,9 @@ applies: a negative viscous slope is not physical and is written as 0 (the measu
 a comment). The breakaway torques of the vertical joints are written as comments: the scenario
 fragment has no stiction key (the robot description holds them, Table 5.4).
 
+A serial robot's drives have one dry friction and one viscous slope for both senses
+(``tau_f_d``, ``f_v``): the fragment gives the mean of the two senses (the senses in a comment).
+
 The statistics follow the construction of Table 6.7 (``description/monte_carlo.rs``): per
 parameter, mu* is the mean of the leg means (each the mean over the campaigns, Eq. 5.8) and
 sigma* the (n - 1) standard deviation of the leg means (Eq. 5.9).
@@ -28,14 +31,25 @@ __all__ = ["leg_means", "joint_friction_fragment", "friction_stats", "friction_s
 #: Fragment key -> (direction, attribute of the fit).
 STEADY_KEYS = {"tau_f_d_plus": (1, "tau_f_d"), "f_v_plus": (1, "f_v"), "tau_f_d_minus": (-1, "tau_f_d"), "f_v_minus": (-1, "f_v")}
 LOAD_KEYS = {"a_2_plus": (1, "a_2"), "a_1_plus": (1, "a_1"), "a_2_minus": (-1, "a_2"), "a_1_minus": (-1, "a_1")}
+#: A serial drive's keys, one dry friction and one viscous slope for both senses
+#: (docs/robot-format.md): key -> (key of the plus sense, of the minus sense, sign of the minus
+#: one). INTERPRETATION: the mean of the two senses (the thesis fits them apart, Table 5.3).
+SERIAL_KEYS = {"tau_f_d": ("tau_f_d_plus", "tau_f_d_minus", -1.0), "f_v": ("f_v_plus", "f_v_minus", 1.0)}
+
+
+def _sense_means(ident: Identification, joint: str) -> dict[str, list[float]]:
+    """Key of Table 5.3 -> the mean over the campaigns of each leg (NaN for a leg without)."""
+    return {key: [mean_sigma([getattr(f, attr).value for f in ident.unloaded(joint, leg, direction)])[0] for leg in LEGS] for key, (direction, attr) in STEADY_KEYS.items()}
 
 
 def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
     """Fragment key -> the mean over the campaigns of each leg that has it."""
-    out: dict[str, list[float]] = {}
-    for key, (direction, attr) in STEADY_KEYS.items():
-        values = [mean_sigma([getattr(f, attr).value for f in ident.unloaded(joint, leg, direction)])[0] for leg in LEGS]
-        out[key] = [v for v in values if not math.isnan(v)]
+    senses = _sense_means(ident, joint)
+    if ident.leg_mechanism == "serial":
+        out = {key: [(p + sign * m) / 2 for p, m in zip(senses[plus], senses[minus])] for key, (plus, minus, sign) in SERIAL_KEYS.items()}
+    else:
+        out = senses
+    out = {key: [v for v in values if not math.isnan(v)] for key, values in out.items()}
     if joint == "q_h":
         for key, (direction, attr) in LOAD_KEYS.items():
             out[key] = [getattr(f, attr).value for f in ident.load_fits if f.direction == direction]
@@ -43,10 +57,9 @@ def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
 
 
 def _physical(key: str, value: float) -> float:
-    """The Section 6.1 rule and the signs the scenario fields allow."""
-    if key.endswith("_plus"):
-        return max(value, 0.0)
-    return max(value, 0.0) if key.startswith("f_v") else min(value, 0.0)
+    """The Section 6.1 rule and the signs the scenario fields allow: only a dry friction or a
+    load coefficient of the minus sense is negative."""
+    return min(value, 0.0) if key.endswith("_minus") and not key.startswith("f_v") else max(value, 0.0)
 
 
 def joint_friction_fragment(ident: Identification) -> str:
@@ -58,7 +71,8 @@ def joint_friction_fragment(ident: Identification) -> str:
     ]
     for joint in ident.joints():
         means = leg_means(ident, joint)
-        if not means and joint != "q_v":
+        breakaways = [b for b in ident.breakaways if b.joint == joint]
+        if not means and not breakaways:
             continue
         lines += ["", f"[model.joint_friction.{joint}]"]
         for key, values in means.items():
@@ -66,12 +80,14 @@ def joint_friction_fragment(ident: Identification) -> str:
             kept = _physical(key, value)
             note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g} (Section 6.1)"
             lines.append(f"{key} = {kept:.9g}{note}")
-        if joint == "q_v":
-            for b_dir, sign in ((1, "plus"), (-1, "minus")):
-                for load in sorted({b.load_kg for b in ident.breakaways}):
-                    values = [b.tau_f_s for b in ident.breakaways if b.direction == b_dir and b.load_kg == load and not b.reason]
-                    if values:
-                        lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.q_v.stiction]): {np.mean(values):.6g} N")
+        if ident.leg_mechanism == "serial":
+            senses = {key: float(np.nanmean(values)) for key, values in _sense_means(ident, joint).items()}
+            lines.append("# the two senses (Table 5.3), averaged above: " + ", ".join(f"{key} = {value:.6g}" for key, value in senses.items()))
+        for b_dir, sign in ((1, "plus"), (-1, "minus")):
+            for load in sorted({b.load_kg for b in breakaways}):
+                values = [b.tau_f_s for b in breakaways if b.direction == b_dir and b.load_kg == load and not b.reason]
+                if values:
+                    lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.{joint}.stiction]): {np.mean(values):.6g} N")
     return "\n".join(lines) + "\n"
 
 

@@ -15,7 +15,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from hexadyn.identify.breakaway import Breakaway, BreakawayOptions, breakaway
-from hexadyn.identify.logs import JOINT_TYPES, LEGS, IdentifyError, Log
+from hexadyn.identify.logs import LEGS, IdentifyError, Log
 from hexadyn.identify.sections import SectionOptions
 from hexadyn.identify.steady import DryViscousFit, LoadFit, SectionPoint, fit_dry_viscous, fit_load, section_points
 
@@ -34,19 +34,26 @@ class Identification:
         fits: one dry/viscous line per (log, joint, leg, direction) and foot load.
         breakaways: one tau_f,s per (log, leg, direction) of the vertical joints.
         load_fits: Eq. 5.12 per (leg, direction) of the horizontal joints, with loaded logs.
+        kinds: joint name -> kind (``"revolute"``, ``"prismatic"``: the units) of the logs'
+            robot, in the order of a leg's joints.
+        leg_mechanism: the logs' robot's ("pantograph" or "serial"): a serial drive has one
+            dry friction and one viscous slope for both senses (its fragment's keys).
     """
 
     points: list[SectionPoint] = field(default_factory=list)
     fits: list[tuple[str, DryViscousFit]] = field(default_factory=list)
     breakaways: list[Breakaway] = field(default_factory=list)
     load_fits: list[LoadFit] = field(default_factory=list)
+    kinds: dict[str, str] = field(default_factory=dict)
+    leg_mechanism: str = "pantograph"
 
     def unloaded(self, joint: str, leg: int, direction: int) -> list[DryViscousFit]:
         """The fits of one joint and direction without foot load, one per campaign."""
         return [f for _, f in self.fits if f.joint == joint and f.leg == leg and f.direction == direction and f.load_kg == 0.0]
 
     def joints(self) -> list[str]:
-        return [j for j in JOINT_TYPES if any(f.joint == j for _, f in self.fits) or (j == "q_v" and self.breakaways)]
+        """The identified joints, in the order of a leg's joints."""
+        return [j for j in self.kinds if any(f.joint == j for _, f in self.fits) or any(b.joint == j for b in self.breakaways)]
 
 
 def experiment_of(log: Log, joint: str, leg: int) -> str | None:
@@ -86,8 +93,9 @@ def identify(
     """
     result = Identification()
     for log in logs:
+        _same_robot(result, log, joint)
         found = False
-        for j in JOINT_TYPES if joint is None else (joint,):
+        for j in log.joints.names if joint is None else (joint,):
             for leg in LEGS:
                 kind = experiment_of(log, j, leg)
                 if kind == SAWTOOTH:
@@ -102,6 +110,19 @@ def identify(
             progress(log.source)
     result.load_fits = _load_fits(result, seed)
     return result
+
+
+def _same_robot(result: Identification, log: Log, joint: str | None) -> None:
+    """Takes the joints and leg mechanism of the log's robot; refuses a log whose robot has
+    other joints or legs than the logs before it, or lacks `joint`."""
+    names = log.joints.names
+    if joint is not None and joint not in names:
+        raise IdentifyError(f"{log.source}: joint = {joint!r}: allowed the robot's joints {', '.join(names)}")
+    kinds = dict(zip(names, log.joints.kinds))
+    if not result.kinds:
+        result.kinds, result.leg_mechanism = kinds, log.leg_mechanism
+    elif kinds != result.kinds or log.leg_mechanism != result.leg_mechanism:
+        raise IdentifyError(f"{log.source}: a {log.leg_mechanism} robot with joints {', '.join(names)}; allowed: the robot of the first log ({result.leg_mechanism}, joints {', '.join(result.kinds)}), one robot per identification")
 
 
 def _sawtooth(result: Identification, log: Log, joint: str, leg: int, options: SectionOptions, seed: int) -> None:

@@ -2,17 +2,18 @@
 
 A log is a time series of joint positions and motor currents (and, optionally, voltages) with
 the robot description it was recorded on and the load hung at each foot (Fig. 5.6). Columns
-are named as in a results folder (``crates/hexadyn/src/robot/columns.rs``): ``t``, ``q_v[2]``,
-``i_q_v[2]``, ``u_q_v[2]``. A measured current column ``i_meas_q_v[2]`` (the current sensor
-of Section 2.3.2 with its 30 Hz analog filter) is used instead of the true current ``i_q_v[2]``
-when the log has it.
+are named as in a results folder (``crates/hexadyn/src/robot/columns.rs``) after the robot's
+joints (``[joints] names``: ``q_r``, ``q_v``, ``q_h`` on AMRU5, ``coxa``, ``femur``, ``tibia``
+on the PhantomX): ``t``, ``q_v[2]``, ``i_q_v[2]``, ``u_q_v[2]``. A measured current column
+``i_meas_q_v[2]`` (the current sensor of Section 2.3.2 with its 30 Hz analog filter) is used
+instead of the true current ``i_q_v[2]`` when the log has it.
 
 CSV layout of a real-robot log (docs/identification.md): a header line, then one row per
-sample; columns ``t`` (s, strictly increasing), for each joint that moved its encoder position
+sample; columns ``t`` (s, strictly increasing), for each joint that moved its position
 ``q_r[i]`` (rad) / ``q_v[i]``, ``q_h[i]`` (m) and its current ``i_q_r[i]``... (A), optionally the
 voltage ``u_q_r[i]``... (V) and ``foot_load_kg[i]`` (the foot load of the loaded experiments,
 constant). Lines starting with ``#`` are comments. The robot description is the one given to
-:func:`load_log` (default: the embedded AMRU5).
+:func:`load_log` (default: the embedded AMRU5), which names the columns.
 """
 
 from __future__ import annotations
@@ -20,15 +21,16 @@ from __future__ import annotations
 import os
 import tomllib
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["IdentifyError", "Log", "load_log", "JOINT_TYPES", "column"]
+from hexadyn.vocabulary import Joints
 
-#: The joint types, in the order of a leg's coordinates (Eq. 3.51).
-JOINT_TYPES = ("q_r", "q_v", "q_h")
+__all__ = ["IdentifyError", "Log", "load_log", "column", "robot_joints"]
+
 LEGS = range(6)
 
 
@@ -40,6 +42,16 @@ def column(kind: str, joint: str, leg: int) -> str:
     """The results column of a joint quantity: ``column("i", "q_v", 2) == "i_q_v[2]"``,
     ``column("q", "q_v", 2) == "q_v[2]"``."""
     return f"{joint}[{leg}]" if kind == "q" else f"{kind}_{joint}[{leg}]"
+
+
+@lru_cache(maxsize=8)
+def robot_joints(robot_text: str | None) -> tuple[Joints, str]:
+    """The joints of a robot description (None: the embedded AMRU5), in the order of a leg's
+    coordinates (Eq. 3.51), and its leg mechanism ("pantograph" or "serial")."""
+    from hexadyn import _core
+
+    text, origin = robot_text or _core.shipped_robot_text("amru5"), "robot description of the log"
+    return Joints.of_robot(text, origin), _core.robot_properties(text, origin)["leg_mechanism"]
 
 
 @dataclass
@@ -62,6 +74,15 @@ class Log:
     robot_text: str | None
     foot_load_kg: tuple[float, ...] = (0.0,) * 6
     motions: dict[tuple[str, int], str] | None = field(default=None)
+
+    @property
+    def joints(self) -> Joints:
+        """The names and kinds of a leg's joints of the log's robot."""
+        return robot_joints(self.robot_text)[0]
+
+    @property
+    def leg_mechanism(self) -> str:
+        return robot_joints(self.robot_text)[1]
 
     @property
     def t(self) -> np.ndarray:
@@ -155,8 +176,13 @@ def _check(log: Log) -> None:
     if np.any(steps <= 0):
         k = int(np.flatnonzero(steps <= 0)[0])
         raise IdentifyError(f"{log.source}: time is not strictly increasing: t[{k}] = {t[k]} s, t[{k + 1}] = {t[k + 1]} s")
-    if not any(log.has(j, leg) for j in JOINT_TYPES for leg in LEGS):
-        raise IdentifyError(f"{log.source}: no joint with both a position (`q_v[2]`...) and a current (`i_q_v[2]` or `i_meas_q_v[2]`) column; the log has {_some(log.frame.columns)}")
+    try:
+        names = log.joints.names
+    except ValueError as exc:
+        raise IdentifyError(f"{log.source}: {exc}") from None
+    if not any(log.has(j, leg) for j in names for leg in LEGS):
+        j = names[1]
+        raise IdentifyError(f"{log.source}: no joint with both a position (`{j}[2]`...) and a current (`i_{j}[2]` or `i_meas_{j}[2]`) column of the robot's joints {', '.join(names)}; the log has {_some(log.frame.columns)}")
     for name in log.frame.columns:
         values = log.frame[name]
         if values.dtype.kind == "f" and not np.all(np.isfinite(values.to_numpy())):

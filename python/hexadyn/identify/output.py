@@ -5,9 +5,11 @@
 - ``table_5_5_load.csv`` / ``.md``: Eq. 5.12 coefficients of the horizontal joints (Table 5.5);
 - ``estimates.csv``: every estimate with its standard error and 95 % intervals (Jacobian and
   bootstrap); ``sections.csv``: every constant-velocity section (velocity, mean torque);
-- ``joint_friction.toml``: the ``[model.joint_friction]`` fragment of a scenario file;
+- ``joint_friction.toml``: the ``[model.joint_friction]`` fragment of a scenario file (on
+  serial legs one dry friction and one viscous slope per joint);
 - ``friction_stats.toml``: the Monte Carlo inputs (``hexadyn montecarlo --friction-stats``);
-- ``figure_5_3_q_r.png``... (Fig. 5.3-5.5, 5.10) in the requested formats.
+- ``figure_5_3_q_r.png``... (Fig. 5.3-5.5, 5.10; ``figure_friction_<joint>`` for another
+  robot's joints) in the requested formats.
 """
 
 from __future__ import annotations
@@ -42,8 +44,10 @@ def save(ident: Identification, out: str | os.PathLike, *, overwrite: bool = Fal
 def _write(ident: Identification, folder: Path, formats: Sequence[str]) -> None:
     from hexadyn.plots import save_figures
 
-    for joint in sorted({f.joint for _, f in ident.fits}, key=("q_r", "q_v", "q_h").index):
-        _table(tables.table_5_3(ident, joint), folder / f"table_5_3_{joint}", f"Table 5.3 ({joint}): dry and viscous friction, unloaded legs; mean and standard deviation over the campaigns (Eq. 5.8-5.9)")
+    # A serial robot's servos are small (the PhantomX's dry friction is 0.59 Nm): three decimals.
+    digits = 3 if ident.leg_mechanism == "serial" else 1
+    for joint in [j for j in ident.kinds if any(f.joint == j for _, f in ident.fits)]:
+        _table(tables.table_5_3(ident, joint), folder / f"table_5_3_{joint}", f"Table 5.3 ({joint}): dry and viscous friction, unloaded legs; mean and standard deviation over the campaigns (Eq. 5.8-5.9)", digits)
     if ident.breakaways:
         _table(tables.table_5_4(ident), folder / "table_5_4_breakaway", "Table 5.4: breakaway friction of the vertical joints (N), mean and standard deviation over the campaigns")
     if ident.load_fits:

@@ -1,5 +1,6 @@
 """The real robot's sensors, for logs that lack them (simulated logs, test fixtures): incremental
-encoders on the motor shafts (500 counts per revolution, Section 2.3.2) and the current sensor
+encoders on the motor shafts (500 counts per revolution, Section 2.3.2; a position servo's own
+sensor on a serial robot, the resolution of its description) and the current sensor
 chain of Section 5.6.2 (Hall-effect sensor, 2 A range, a 30 Hz analog low-pass filter, then a
 3 Hz digital low-pass filter in the controller), with Gaussian noise.
 
@@ -16,7 +17,7 @@ import numpy as np
 import pandas as pd
 from scipy import signal
 
-from hexadyn.identify.logs import JOINT_TYPES, LEGS, Log, column
+from hexadyn.identify.logs import LEGS, Log, column
 from hexadyn.identify.torques import joint_constants
 
 __all__ = ["SensorModel", "low_pass", "measure"]
@@ -78,7 +79,7 @@ def measure(log: Log, sensors: SensorModel) -> Log:
     frame = log.frame.copy()
     dt = float(np.median(np.diff(log.t)))
     added = {}
-    for joint in JOINT_TYPES:
+    for joint in log.joints.names:
         for leg in LEGS:
             if not log.has(joint, leg):
                 continue

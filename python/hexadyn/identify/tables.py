@@ -18,8 +18,8 @@ from hexadyn.identify.logs import LEGS
 
 __all__ = ["mean_sigma", "table_5_3", "table_5_4", "table_5_5", "estimates", "markdown"]
 
-#: Units of the parameters per joint type (Table 5.3).
-UNITS = {"q_r": ("Nm", "Nms"), "q_v": ("N", "Ns/m"), "q_h": ("N", "Ns/m")}
+#: Units of the dry friction and the viscous slope per joint kind (Table 5.3: Nm, Nms for q_r).
+UNITS = {"revolute": ("Nm", "Nms"), "prismatic": ("N", "Ns/m")}
 
 
 def mean_sigma(values: list[float]) -> tuple[float, float]:
@@ -36,7 +36,7 @@ def _leg_columns() -> pd.MultiIndex:
 
 def table_5_3(ident: Identification, joint: str) -> pd.DataFrame:
     """Rows tau_f,d^+, f_v^+, tau_f,d^-, f_v^- of `joint` (unloaded), columns (leg, mu/sigma)."""
-    dry, viscous = UNITS[joint]
+    dry, viscous = UNITS[ident.kinds[joint]]
     rows = {}
     for direction, sign in ((1, "+"), (-1, "-")):
         for name, unit, attr in ((f"tau_f,d^{sign} ({dry})", dry, "tau_f_d"), (f"f_v^{sign} ({viscous})", viscous, "f_v")):
@@ -83,7 +83,7 @@ def estimates(ident: Identification) -> pd.DataFrame:
             rows.append(_row("loaded logs", "q_h", f.leg, f.direction, float("nan"), name, e, len(f.loads_kg)))
     for b in ident.breakaways:
         nan = float("nan")
-        rows.append(_row(b.source, "q_v", b.leg, b.direction, b.load_kg, "tau_f_s", Estimate(b.tau_f_s, nan, nan, nan, nan, nan), 0 if b.reason else 1) | {"note": b.reason})
+        rows.append(_row(b.source, b.joint, b.leg, b.direction, b.load_kg, "tau_f_s", Estimate(b.tau_f_s, nan, nan, nan, nan, nan), 0 if b.reason else 1) | {"note": b.reason})
     return pd.DataFrame(rows)
 
 

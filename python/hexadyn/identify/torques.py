@@ -1,7 +1,7 @@
 """Joint torques from a log: the motor torque of the measured current (Eq. 3.90 through the
-reduction, tau_m = n k_t i, Eq. 5.17) minus what the leg itself needs, computed by the leg
-model of the engine (Eq. 3.37 on a single leg, ``hexadyn._core.LegModel``): its gravity and
-the foot load of the loaded experiments (Fig. 5.6). What remains is the friction torque at
+reduction, tau_m = n k_t i, Eq. 5.17; on a position servo the current of its motor) minus what
+the leg itself needs, computed by the leg model of the engine (Eq. 3.37 on a single leg of
+either mechanism, ``hexadyn._core.LegModel``): its gravity and the foot load of the loaded experiments (Fig. 5.6). What remains is the friction torque at
 constant velocity (Eq. 5.7, Coriolis and centrifugal terms negligible).
 
 What is left of the velocity transient in an averaging window is removed as the leg's inertia
@@ -20,7 +20,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from hexadyn.identify.logs import JOINT_TYPES, Log
+from hexadyn.identify.logs import Log
 
 __all__ = ["leg_model", "friction_torque", "joint_constants"]
 
@@ -47,7 +47,7 @@ def sampling_factor(log: Log, joint: str, leg: int, q: np.ndarray) -> float:
     """phi of the module docs for the joint's current column at the leg configuration q (3,)."""
     if log.measured_current(joint, leg):
         return 1.0
-    k = JOINT_TYPES.index(joint)
+    k = log.joints.index(joint)
     c = joint_constants(log, joint, leg)
     unit = np.zeros((1, 3))
     unit[0, k] = 1.0
@@ -64,9 +64,9 @@ def friction_torque(log: Log, joint: str, leg: int, rows: slice | np.ndarray = s
     """tau_m - tau_grav - tau_iner - tau_load of the joint over `rows` of the log (Eq. 5.7 and
     5.14): the leg model at the logged positions, the joint at `velocity` and `acceleration`
     (a section's means), the other joints of the leg still."""
-    k = JOINT_TYPES.index(joint)
+    k = log.joints.index(joint)
     i = log.current(joint, leg)[rows]
-    q = np.column_stack([log.position(j, leg)[rows] if _has_position(log, j, leg) else np.full(len(i), _default(j)) for j in JOINT_TYPES])
+    q = np.column_stack([log.position(j, leg)[rows] if _has_position(log, j, leg) else np.full(len(i), _mid_range(log, j, leg)) for j in log.joints.names])
     qd, qdd = np.zeros_like(q), np.zeros_like(q)
     qd[:, k] = velocity
     if acceleration:
@@ -84,7 +84,10 @@ def _has_position(log: Log, joint: str, leg: int) -> bool:
     return f"{joint}[{leg}]" in log.frame
 
 
-def _default(joint: str) -> float:
-    # A joint whose position the log lacks: the middle of the AMRU5 strokes (Table 5.2). Only
-    # the gravity of a leg depends on it, which is below 5 % of the currents (Section 5.2.1).
-    return {"q_r": 0.0, "q_v": 0.0575, "q_h": 0.03}[joint]
+def _mid_range(log: Log, joint: str, leg: int) -> float:
+    # A joint whose position the log lacks: the middle of its range (on AMRU5 the strokes of
+    # Table 5.2). Only the gravity of the leg depends on it, below 5 % of the currents on
+    # AMRU5 (Section 5.2.1); a serial leg's gravity depends on every joint, so its logs should
+    # hold the three positions of the leg.
+    c = joint_constants(log, joint, leg)
+    return 0.5 * (c["lower"] + c["upper"])
