@@ -11,13 +11,18 @@ use hexadyn::robot::simulation::run;
 use hexadyn::scenario::{run_scenario, settled_robot, Scenario, ScenarioController};
 
 fn scenario(text_replacements: &[(&str, &str)]) -> Scenario {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios/ground_detection.toml");
+    shipped("ground_detection", text_replacements)
+}
+
+/// The shipped scenario `name` with the text replacements.
+fn shipped(name: &str, text_replacements: &[(&str, &str)]) -> Scenario {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../python/hexadyn/scenarios/{name}.toml"));
     let mut text = std::fs::read_to_string(&path).unwrap();
     for (from, to) in text_replacements {
         assert!(text.contains(from), "`{from}` not in the scenario");
         text = text.replacen(from, to, 1);
     }
-    Scenario::from_str(&text, "ground_detection.toml", Path::new(".")).unwrap()
+    Scenario::from_str(&text, &format!("{name}.toml"), Path::new(".")).unwrap()
 }
 
 /// One row of Table 5.7: a stop of the tested leg.
@@ -90,6 +95,36 @@ fn table_5_7_experiment_on_the_full_model() {
     }
 }
 
+/// The experiment on the PhantomX's serial legs (`phantomx_ground_detection`, two legs, two
+/// trials per threshold): Section 5.6.3 on the leg's own Jacobian and dynamics. Every trial
+/// stops with the foot on the ground, never in the air, and the estimate at the stop is the
+/// true force through the estimator's 3 Hz filter, as on AMRU5.
+#[test]
+fn table_5_7_experiment_on_serial_legs() {
+    let s = shipped("phantomx_ground_detection", &[("legs = [0, 1, 2, 3, 4, 5]", "legs = [0, 3]"), ("trials = 4", "trials = 2"), ("duration_s = 606.0", "duration_s = 106.0")]);
+    let e = s.ground_detection.clone().unwrap();
+    let r = run_scenario(&s, |_| {}).unwrap();
+    let trials = trials(&r.series);
+    for &leg in &e.legs {
+        for &threshold in &e.thresholds {
+            let n = trials.iter().filter(|t| t.leg == leg && t.threshold == threshold).count();
+            assert_eq!(n, e.trials, "leg {leg}, {threshold} N: {n} stops");
+        }
+    }
+    for t in &trials {
+        let error = (t.estimate - t.filtered_true_force) / t.filtered_true_force;
+        eprintln!("{t:?}: estimate {:+.1} % from the filtered true force", 100.0 * error);
+        assert!(error.abs() < 0.15, "{t:?}: estimate {:.1} % from the filtered true force", 100.0 * error);
+        assert!(t.estimate >= t.threshold && t.true_force > 0.0, "{t:?}");
+    }
+    let v = |n: &str| r.series.values(n).unwrap();
+    for l in 0..6 {
+        let (d, pen) = (v(&format!("gnd_detected[{l}]")), v(&format!("penetration[{l}]")));
+        let false_detections = (0..d.len()).filter(|&k| pen[k] < -AIR && d[k] == 1.0).count();
+        assert_eq!(false_detections, 0, "leg {l}");
+    }
+}
+
 /// Issue 11's target: with the model's own friction the true force at detection is within
 /// 15 % of the threshold. On this model the true force at detection is 1.8-2.0 times the
 /// threshold: the foot meets the stiff ground (K_gnd = 1e6 N/m^1.5, Table 3.3) at 3 cm/s and the
@@ -151,3 +186,4 @@ fn no_false_detection_over_100_swing_phases() {
     assert!(swings >= 100, "{swings} swing phases");
     assert!(max_lowering < AIR_BOUND, "largest estimate in the air while lowering: {max_lowering:.1} N");
 }
+

@@ -545,13 +545,16 @@ fn gait_errors_name_the_field() {
     let s = field_error(&with(v, "mode = \"gait\"", "mode = \"gait\"\n[[control.motion]]\nleg = 0\njoint = \"q_v\"\nkind = \"sine\"\namplitude = 0.001\nfrequency_hz = 1.0"), "control.motion");
     assert!(s.contains("mode = \"pi\""), "{s}");
 
-    // The experiment of Section 5.6.3 lowers the pantograph's vertical joint: refused on serial
-    // legs, on the line of the mode.
-    let px = "phantomx_stand";
-    let s = field_error(&with(px, "mode = \"pi\"", "mode = \"ground_detection\"\n[ground_detection]\nlegs = [0]\n#"), "control.mode");
-    assert!(s.contains("\"ground_detection\"") && s.contains("serial"), "{s}");
-    let line = shipped(px).lines().position(|l| l.starts_with("mode =")).unwrap() + 1;
-    assert!(s.starts_with(&format!("bad.toml:{line}:")), "{s}");
+    // The experiment of Section 5.6.3 on serial legs: a foot height the leg reaches up and down,
+    // thresholds below the robot's weight (AMRU5's Table 5.7 forces are not the PhantomX's),
+    // the feed-forward for servos only.
+    let px = "phantomx_ground_detection";
+    let s = field_error(&with(px, "amplitude_m = 0.03       #", "amplitude_m = 0.5 #"), "ground_detection.amplitude_m");
+    assert!(s.contains("0.5") && s.contains("reaches above and below"), "{s}");
+    let s = field_error(&with(px, "thresholds_n = [2.14, 2.68, 3.21]", "thresholds_n = [40.0]"), "ground_detection.thresholds_n[0]");
+    assert!(s.contains("40") && s.contains("below the robot's weight"), "{s}");
+    let s = field_error(&with("ground_detection", "period_s = 8.0", "period_s = 8.0\nfriction_feedforward = true"), "ground_detection.friction_feedforward");
+    assert!(s.contains("PI loops"), "{s}");
 }
 
 /// A heading from a CSV file next to the scenario; a malformed file is reported with its line.

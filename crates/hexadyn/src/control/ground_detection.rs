@@ -139,6 +139,11 @@ impl<L: GroundSensingLeg> GroundDetector<L> {
         })
     }
 
+    /// The kinematics of the legs.
+    pub fn legs(&self) -> &[L; LEG_COUNT] {
+        &self.legs
+    }
+
     /// The torques of the last update.
     pub fn estimate(&self) -> Option<&TorqueEstimate> {
         self.estimator.estimate()

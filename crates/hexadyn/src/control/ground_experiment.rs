@@ -1,5 +1,6 @@
 //! The ground detection experiment of Section 5.6.3 as a controller: one leg at a time is
-//! lifted, then lowered onto the ground in a sawtooth of its vertical joint; when the
+//! lifted, then lowered onto the ground in a sawtooth of its vertical joint (on AMRU5; of its
+//! foot's height on other legs, [`LoweredLeg`]); when the
 //! [`GroundDetector`] reports the ground the reference stops where the joint is, and the motion
 //! resumes as soon as the sawtooth reference rises above that point (the reference q_v* goes on
 //! being computed meanwhile). Every other joint holds its initial position; all 18 joints are
@@ -23,13 +24,49 @@ use std::rc::Rc;
 
 use serde::{Deserialize, Serialize};
 
-use super::ground_detection::{GroundDetector, LegDetection};
+use nalgebra::Vector3;
+
+use super::ground_detection::{GroundDetector, GroundSensingLeg, LegDetection};
 use super::interface::{Command, Controller, Measurements};
-use super::{pi_command, DigitalPi};
-use crate::hexapod::{LegKinematics, JOINTS, LEG_COUNT};
+use super::gait::free::settling_time;
+use super::{joint_command, DigitalPi, FrictionFeedForward};
+use crate::hexapod::{Leg, LegChain, LegKinematics, SerialLegKinematics, JOINTS, LEG_COUNT};
 
 /// Rest after each tested leg is put back on the ground (s).
 pub const REST_S: f64 = 1.0;
+
+/// How the experiment lowers a leg: its descent s (> 0 further down) and the joints that put
+/// the foot at a given descent.
+pub trait LoweredLeg: GroundSensingLeg {
+    /// s at the joints `q` of the leg.
+    fn descent(&self, q: &Vector3<f64>) -> f64;
+    /// The joints at the descent `s`, the others as in `stance`.
+    fn lowered(&self, stance: &Vector3<f64>, s: f64) -> Vector3<f64>;
+}
+
+/// AMRU5's pantograph: s = q_v, the vertical joint of Section 5.6.3 (the foot about 6 q_v down,
+/// Eq. B.2).
+impl LoweredLeg for LegKinematics {
+    fn descent(&self, q: &Vector3<f64>) -> f64 {
+        q[1]
+    }
+    fn lowered(&self, stance: &Vector3<f64>, s: f64) -> Vector3<f64> {
+        Vector3::new(stance[0], s, stance[2])
+    }
+}
+
+/// A serial leg: s = −z of the foot in the leg frame, the foot moved straight down from its
+/// stance by the inverse kinematics of Eq. 7.7 (the closest point within the joint ranges
+/// where it does not reach).
+impl LoweredLeg for SerialLegKinematics {
+    fn descent(&self, q: &Vector3<f64>) -> f64 {
+        -self.foot(q).z
+    }
+    fn lowered(&self, stance: &Vector3<f64>, s: f64) -> Vector3<f64> {
+        let p = self.foot(stance);
+        Leg::inverse(self, &Vector3::new(p.x, p.y, -s), stance).map_or(*stance, |ik| ik.joints)
+    }
+}
 
 /// The `[ground_detection]` table of a scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -44,12 +81,20 @@ pub struct GroundExperiment {
     /// Trials per threshold (4 in Table 5.7).
     #[serde(default = "four")]
     pub trials: usize,
-    /// Sawtooth amplitude A of q_v (m), Table 5.6.
+    /// Sawtooth amplitude A of q_v (m), Table 5.6 (of the foot's height on other legs).
     #[serde(default = "table_5_6_amplitude", rename = "amplitude_m")]
     pub amplitude: f64,
     /// Sawtooth period P (s), Table 5.6.
     #[serde(default = "table_5_6_period", rename = "period_s")]
     pub period: f64,
+    /// Whether the master adds its friction feed-forward to the servo goals (as
+    /// `gait.friction_feedforward`; position servos only).
+    #[serde(default)]
+    pub friction_feedforward: bool,
+    /// The feed-forward the scenario built for `friction_feedforward` (from the robot as its
+    /// file describes it).
+    #[serde(skip)]
+    pub feedforward: Option<FrictionFeedForward>,
 }
 
 fn all_legs() -> Vec<usize> {
@@ -70,12 +115,12 @@ fn table_5_6_period() -> f64 {
 
 impl Default for GroundExperiment {
     fn default() -> Self {
-        GroundExperiment { legs: all_legs(), thresholds: table_5_7_thresholds(), trials: 4, amplitude: table_5_6_amplitude(), period: table_5_6_period() }
+        GroundExperiment { legs: all_legs(), thresholds: table_5_7_thresholds(), trials: 4, amplitude: table_5_6_amplitude(), period: table_5_6_period(), friction_feedforward: false, feedforward: None }
     }
 }
 
 impl GroundExperiment {
-    /// q_v speed of the sawtooth, 4A/P (m/s).
+    /// Speed of the sawtooth, 4A/P (m/s).
     pub fn speed(&self) -> f64 {
         4.0 * self.amplitude / self.period
     }
@@ -90,12 +135,12 @@ impl GroundExperiment {
         self.legs.len() as f64 * self.leg_duration()
     }
 
-    /// Where the schedule is at `t`, the stance q_v,0 of each leg in the joint positions `base`.
-    fn phase(&self, t: f64, base: &[f64; JOINTS]) -> Option<Phase> {
+    /// Where the schedule is at `t`, `stance` the descent s_0 of each leg at the start (q_v,0).
+    fn phase(&self, t: f64, stance: &[f64; LEG_COUNT]) -> Option<Phase> {
         let d = self.leg_duration();
         let index = (t / d).floor() as usize;
         let leg = *self.legs.get(index)?;
-        let stance = base[3 * leg + 1];
+        let stance = stance[leg];
         let tau = t - index as f64 * d;
         let (a, p, v) = (self.amplitude, self.period, self.speed());
         let cycles = self.thresholds.len() * self.trials;
@@ -116,7 +161,7 @@ impl GroundExperiment {
 
 struct Phase {
     leg: usize,
-    /// Sawtooth reference q_v* of the tested leg (m).
+    /// Sawtooth reference s* of the tested leg (q_v* on AMRU5, m).
     reference: f64,
     /// (threshold index, trial, descending) during the sawtooth periods.
     trial: Option<(usize, usize, bool)>,
@@ -148,63 +193,77 @@ pub struct GroundExperimentState {
     pub stops: Vec<Stop>,
 }
 
-/// The experiment controller.
-pub struct GroundExperimentController {
+/// The experiment controller on legs `L`.
+pub struct GroundExperimentController<L> {
     pub experiment: GroundExperiment,
     pub pis: [DigitalPi; JOINTS],
-    /// Joint positions held, and the stance q_v,0 of the tested legs.
+    /// Joint positions held.
     pub base: [f64; JOINTS],
-    pub detector: GroundDetector<LegKinematics>,
-    /// q_v where the tested leg stopped.
+    /// The descent of each leg at `base`.
+    stance: [f64; LEG_COUNT],
+    pub detector: GroundDetector<L>,
+    legs: [L; LEG_COUNT],
+    /// The descent where the tested leg stopped.
     hold: Option<f64>,
+    /// When the descending half of the current sawtooth period began (s).
+    descent_start: Option<f64>,
     state: Rc<RefCell<GroundExperimentState>>,
 }
 
-impl GroundExperimentController {
-    /// The controller and the state it publishes.
-    pub fn new(experiment: GroundExperiment, pis: [DigitalPi; JOINTS], base: [f64; JOINTS], detector: GroundDetector<LegKinematics>) -> (Self, Rc<RefCell<GroundExperimentState>>) {
+/// The joints of `leg` in the 18 joint values `q`.
+fn leg_joints(q: &[f64; JOINTS], leg: usize) -> Vector3<f64> {
+    Vector3::new(q[3 * leg], q[3 * leg + 1], q[3 * leg + 2])
+}
+
+impl<L: LoweredLeg + Clone> GroundExperimentController<L> {
+    /// The controller on the legs of `detector` and the state it publishes.
+    pub fn new(experiment: GroundExperiment, pis: [DigitalPi; JOINTS], base: [f64; JOINTS], detector: GroundDetector<L>) -> (Self, Rc<RefCell<GroundExperimentState>>) {
+        let legs = detector.legs().clone();
+        let stance = std::array::from_fn(|l| legs[l].descent(&leg_joints(&base, l)));
         let state = Rc::new(RefCell::new(GroundExperimentState::default()));
-        (GroundExperimentController { experiment, pis, base, detector, hold: None, state: state.clone() }, state)
+        (GroundExperimentController { experiment, pis, base, stance, detector, legs, hold: None, descent_start: None, state: state.clone() }, state)
     }
 }
 
-impl Controller for GroundExperimentController {
+impl<L: LoweredLeg> Controller for GroundExperimentController<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let detections = self.detector.update(m);
         let mut references = self.base;
         let mut st = self.state.borrow_mut();
         st.stop = None;
         st.trial = None;
-        if let Some(phase) = self.experiment.phase(m.t, &self.base) {
-            let k = 3 * phase.leg + 1;
-            references[k] = phase.reference;
+        if let Some(phase) = self.experiment.phase(m.t, &self.stance) {
+            let l = phase.leg;
             match phase.trial {
                 Some((threshold, trial, descending)) => {
+                    self.descent_start = if descending { self.descent_start.or(Some(m.t)) } else { None };
+                    // The filters follow the reversal at the top of the sawtooth (see
+                    // SETTLING_TIME_CONSTANTS): no stop before.
+                    let settled = self.descent_start.is_some_and(|t0| m.t - t0 >= settling_time() - 0.5 * self.pis[0].dt);
                     let threshold = self.experiment.thresholds[threshold];
                     self.detector.threshold = threshold;
-                    st.trial = Some((phase.leg, threshold, trial));
+                    st.trial = Some((l, threshold, trial));
                     match self.hold {
                         // Resume once the reference rises above the stop point.
-                        Some(q) if phase.reference < q => self.hold = None,
+                        Some(s) if phase.reference < s => self.hold = None,
                         Some(_) => {}
-                        None if descending && detections[phase.leg].detected => {
-                            self.hold = Some(m.positions[k]);
-                            let stop = Stop { t: m.t, leg: phase.leg, threshold, trial, estimate: detections[phase.leg].force };
+                        None if descending && settled && detections[l].detected => {
+                            self.hold = Some(self.legs[l].descent(&leg_joints(&m.positions, l)));
+                            let stop = Stop { t: m.t, leg: l, threshold, trial, estimate: detections[l].force };
                             st.stop = Some(stop);
                             st.stops.push(stop);
                         }
                         None => {}
                     }
                 }
-                None => self.hold = None,
+                None => (self.hold, self.descent_start) = (None, None),
             }
-            if let Some(q) = self.hold {
-                references[k] = q;
-            }
+            let q = self.legs[l].lowered(&leg_joints(&self.base, l), self.hold.unwrap_or(phase.reference));
+            references[3 * l..3 * l + 3].copy_from_slice(q.as_slice());
         }
         st.holding = self.hold.is_some();
         st.detections = detections;
-        pi_command(&mut self.pis, references, m)
+        joint_command(&mut self.pis, self.experiment.feedforward.as_mut(), references, m)
     }
 }
 
@@ -218,7 +277,7 @@ mod tests {
         assert!((e.speed() - 0.005).abs() < 1e-15);
         assert!((e.leg_duration() - (4.0 + 32.0 + REST_S)).abs() < 1e-12);
         let stance = 0.06;
-        let base = [stance; JOINTS];
+        let base = [stance; LEG_COUNT];
         let at = |t: f64| e.phase(t, &base).unwrap();
         // Lift over P/4 = 2 s to q_v,0 − A.
         assert!((at(1.0).reference - 0.055).abs() < 1e-12 && at(1.0).trial.is_none());

@@ -19,7 +19,9 @@ use crate::control::{GroundExperiment, JointMotion};
 use crate::description::{Robot, RobotDescription, AMRU5_TOML, SHIPPED_ROBOTS};
 use crate::fields::{Ctx, DescriptionError};
 use crate::description::SerialRobot;
-use crate::hexapod::{default_serial_height, Leg, PantographJoint, SerialLegKinematics, JOINTS};
+use crate::hexapod::{default_serial_height, Leg, LegChain, PantographJoint, SerialLegKinematics, JOINTS};
+use crate::mbs::STANDARD_GRAVITY;
+use nalgebra::Vector3;
 use crate::physics::LOAD_GRAVITY;
 use crate::robot::model::FrictionModel;
 use crate::robot::simulation::PlantOptions;
@@ -352,7 +354,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     // Control mode and the walking set-up: in gait mode the initial joints come from the gait.
     let mode = raw.control.mode;
     let gait = match (mode, &raw.gait) {
-        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, feedforward, dir, h.duration_s).map_err(e)?),
+        (ControlMode::Gait, Some(g)) => Some(gait::validate(g, c, &robot, feedforward.clone(), dir, h.duration_s).map_err(e)?),
         (ControlMode::Gait, None) => {
             return Err(e(c.err("gait", "<missing>", "missing table", "a [gait] table with control.mode = \"gait\" (period_s, pattern, [gait.heading]; see the shipped walking scenarios)")));
         }
@@ -424,10 +426,13 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
 
     let ground_detection = match (mode, &raw.ground_detection) {
         (ControlMode::GroundDetection, Some(g)) => {
-            let Robot::Pantograph(d) = &robot else {
-                return Err(e(c.err("control.mode", "\"ground_detection\"", "not available on serial legs yet", "pi, unpowered or gait with a serial robot (the experiment of Section 5.6.3 is written for the pantograph's vertical joint)")));
+            let mut g = validate_ground_detection(g, c, &robot, &initial).map_err(e)?;
+            g.feedforward = match (g.friction_feedforward, &feedforward) {
+                (false, _) => None,
+                (true, Some(f)) => Some(f.clone()),
+                (true, None) => return Err(e(c.err("ground_detection.friction_feedforward", "true", "a feed-forward for position servos", "false with a robot whose joints are driven by PI loops (their integral action takes the friction)"))),
             };
-            Some(validate_ground_detection(g, c, d, &initial).map_err(e)?)
+            Some(g)
         }
         (ControlMode::GroundDetection, None) => {
             return Err(e(c.err("ground_detection", "<missing>", "missing table", "a [ground_detection] table with control.mode = \"ground_detection\" (see python/hexadyn/scenarios/ground_detection.toml)")));
@@ -639,10 +644,11 @@ fn validate_motion(m: &RawMotion, path: &str, c: &Ctx, robot: &Robot, joints: &[
     Ok(Motion { leg, joint, motion })
 }
 
-/// `[ground_detection]`: legs 0..5 each at most once, positive thresholds, at least one trial,
-/// a sawtooth inside the q_v stroke around the initial q_v of each tested leg, and a period of
-/// at least four control periods.
-fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &RobotDescription, initial: &Initial) -> std::result::Result<GroundExperiment, DescriptionError> {
+/// `[ground_detection]`: legs 0..5 each at most once, thresholds between 0 and the robot's
+/// weight, at least one trial, a sawtooth the tested legs follow around their initial joints
+/// (inside the q_v stroke on AMRU5, the foot's height reached up and down on other legs), and a
+/// period of at least four control periods.
+fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &Robot, initial: &Initial) -> std::result::Result<GroundExperiment, DescriptionError> {
     if g.legs.is_empty() {
         return Err(c.err("ground_detection.legs", "[]", "no leg to test", "a list of legs 0..5"));
     }
@@ -661,16 +667,31 @@ fn validate_ground_detection(g: &GroundExperiment, c: &Ctx, robot: &RobotDescrip
     if g.thresholds.is_empty() {
         return Err(c.err("ground_detection.thresholds_n", "[]", "no threshold", "a list of forces > 0 (N), e.g. [40, 50, 60]"));
     }
+    // One foot never carries more than the whole robot: a higher threshold is never reached.
+    let weight = robot.total_mass_kg() * STANDARD_GRAVITY;
     for (n, &f) in g.thresholds.iter().enumerate() {
-        c.positive(&format!("ground_detection.thresholds_n[{n}]"), f)?;
+        c.check(f > 0.0 && f < weight, &format!("ground_detection.thresholds_n[{n}]"), f, &format!("a force in (0, {}) N, below the robot's weight (the default [40, 50, 60] is AMRU5's Table 5.7: 12-18 % of its weight)", short(weight)))?;
     }
     c.check(g.trials >= 1, "ground_detection.trials", g.trials as f64, "an integer >= 1")?;
-    let period = robot.controller.period_s;
+    let period = robot.period();
     c.check(g.period.is_finite() && g.period >= 4.0 * period, "ground_detection.period_s", g.period, &format!("a finite period >= {} s (four control periods)", 4.0 * period))?;
-    let (lo, hi) = robot.joint_range(PantographJoint::Vertical);
-    let tol = STROKE_TOLERANCE * (hi - lo);
-    let room = g.legs.iter().map(|&l| initial.joints[3 * l + 1]).map(|q| (q - lo).min(hi - q)).fold(f64::INFINITY, f64::min);
-    c.check(g.amplitude > 0.0 && g.amplitude <= room + tol, "ground_detection.amplitude_m", g.amplitude, &format!("a value in (0, {}] m, so that q_v ± amplitude stays in the q_v stroke [{}, {}] m around initial.q_v_m", short(room), short(lo), short(hi)))?;
+    match robot {
+        Robot::Pantograph(d) => {
+            let (lo, hi) = d.joint_range(PantographJoint::Vertical);
+            let tol = STROKE_TOLERANCE * (hi - lo);
+            let room = g.legs.iter().map(|&l| initial.joints[3 * l + 1]).map(|q| (q - lo).min(hi - q)).fold(f64::INFINITY, f64::min);
+            c.check(g.amplitude > 0.0 && g.amplitude <= room + tol, "ground_detection.amplitude_m", g.amplitude, &format!("a value in (0, {}] m, so that q_v ± amplitude stays in the q_v stroke [{}, {}] m around initial.q_v_m", short(room), short(lo), short(hi)))?;
+        }
+        Robot::Serial(s) => {
+            c.check(g.amplitude > 0.0 && g.amplitude.is_finite(), "ground_detection.amplitude_m", g.amplitude, "a foot height > 0 m")?;
+            let legs = SerialLegKinematics::hexapod(&s.hexapod.legs).map_err(|err| c.err("scenario.robot", s.name.clone(), &format!("no leg kinematics: {err}"), "serial legs with valid joint ranges"))?;
+            for &l in &g.legs {
+                let foot = legs[l].foot(&Vector3::new(initial.joints[3 * l], initial.joints[3 * l + 1], initial.joints[3 * l + 2]));
+                let reached = [1.0, -1.0].iter().all(|side| legs[l].reaches_point(&(foot + Vector3::z() * (side * g.amplitude))));
+                c.check(reached, "ground_detection.amplitude_m", g.amplitude, &format!("a foot height that leg {l} reaches above and below its initial foothold (the sawtooth of a serial leg moves its foot straight up and down)"))?;
+            }
+        }
+    }
     Ok(g.clone())
 }
 

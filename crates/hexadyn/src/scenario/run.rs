@@ -12,7 +12,8 @@ use super::summary::{summarize, GaitStats, RunStats};
 use super::{ControlMode, GaitSummary, Result, Scenario, ScenarioError, Summary};
 use crate::control::gait::schedule::GaitState;
 use crate::control::{joint_pis, Controller, GroundDetector, GroundExperimentController, GroundExperimentState, JointPiController, JointReferences, Unpowered};
-use crate::hexapod::LegKinematics;
+use crate::description::Robot as Description;
+use crate::hexapod::{LegKinematics, SerialLegKinematics};
 use crate::robot::columns::{record_row, ColumnGroups};
 use crate::robot::model::{FrictionModel, Robot};
 use crate::robot::recorder::{Recorder, TimeSeries};
@@ -171,11 +172,20 @@ pub(super) fn controller(s: &Scenario) -> (Box<dyn Controller>, Published) {
         ControlMode::Unpowered => (Box::new(Unpowered), Published::default()),
         ControlMode::GroundDetection => {
             let e = s.ground_detection.clone().expect("ground_detection mode has a validated [ground_detection]");
-            let d = s.robot.pantograph().expect("ground detection is validated on pantograph legs only");
-            let legs = LegKinematics::hexapod_from_description(d).expect("a validated description has valid leg kinematics");
-            let detector = GroundDetector::new(&s.robot, legs, s.plant.period, e.thresholds[0]);
-            let (controller, state) = GroundExperimentController::new(e, joint_pis(&d.joint_pi_gains(), s.plant.period), s.initial.joints, detector);
-            (Box::new(controller), Published { gait: None, ground: Some(state) })
+            let pis = joint_pis(&s.robot.pi_gains(), s.plant.period);
+            let (controller, state): (Box<dyn Controller>, _) = match &s.robot {
+                Description::Pantograph(d) => {
+                    let legs = LegKinematics::hexapod_from_description(d).expect("a validated description has valid leg kinematics");
+                    let (c, state) = GroundExperimentController::new(e.clone(), pis, s.initial.joints, GroundDetector::new(&s.robot, legs, s.plant.period, e.thresholds[0]));
+                    (Box::new(c), state)
+                }
+                Description::Serial(r) => {
+                    let legs = SerialLegKinematics::hexapod(&r.hexapod.legs).expect("a validated description has valid leg kinematics");
+                    let (c, state) = GroundExperimentController::new(e.clone(), pis, s.initial.joints, GroundDetector::new(&s.robot, legs, s.plant.period, e.thresholds[0]));
+                    (Box::new(c), state)
+                }
+            };
+            (controller, Published { gait: None, ground: Some(state) })
         }
     }
 }

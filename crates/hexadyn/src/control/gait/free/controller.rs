@@ -13,7 +13,7 @@
 use nalgebra::{Vector2, Vector3};
 
 use super::elevator::{resistance, retreat};
-use super::landing::SETTLING_TIME_CONSTANTS;
+use super::landing::settling_time;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
 use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};
@@ -23,7 +23,7 @@ use crate::control::gait::walk::{LegState, Walk};
 use crate::control::gait::controller::{centre_velocity, estimated_pose, joints_of, pose_of, GaitDiagnostics};
 use crate::control::gait::heading::{Heading, HeadingSource};
 use crate::control::gait::pattern::FootPhase;
-use crate::control::{joint_command, Command, Controller, DigitalPi, FrictionFeedForward, Measurements, DIGITAL_CUTOFF_HZ};
+use crate::control::{joint_command, Command, Controller, DigitalPi, FrictionFeedForward, Measurements};
 use crate::hexapod::{Leg as LegMechanism, LegKinematics, Workspace, JOINTS};
 use crate::spatial::Htm;
 
@@ -446,7 +446,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         }
         let contact = self.landing.ground_contact(m);
         let forces = self.landing.foot_forces();
-        let settling = SETTLING_TIME_CONSTANTS / (std::f64::consts::TAU * DIGITAL_CUTOFF_HZ);
+        let settling = settling_time();
         let before = self.walk.body.as_ref().expect("started").pose;
         let estimated = estimated_pose(m, &before);
 

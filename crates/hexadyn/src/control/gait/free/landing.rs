@@ -100,6 +100,11 @@ pub const THESIS_CURRENT_THRESHOLD: f64 = 40.0;
 /// the foot at the 4.5 cm/s of the landing).
 pub const SETTLING_TIME_CONSTANTS: f64 = 3.0;
 
+/// [`SETTLING_TIME_CONSTANTS`] time constants of the 3 Hz filters (s).
+pub fn settling_time() -> f64 {
+    SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ)
+}
+
 impl<L: GroundSensingLeg> MotorCurrent<L> {
     /// The detector of `robot` with the kinematics `legs` of its legs at the control period
     /// `dt` (s) with the force `threshold` (N).
@@ -108,7 +113,7 @@ impl<L: GroundSensingLeg> MotorCurrent<L> {
             detector: GroundDetector::new(robot, legs, dt, threshold),
             detections: Default::default(),
             sliding: [0.0; 6],
-            settling: SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ),
+            settling: settling_time(),
             dt,
         }
     }
@@ -221,7 +226,7 @@ mod tests {
         }
         let (out, _) = settled(&robot, 0.005, 3.0 * THESIS_CURRENT_THRESHOLD);
         let first = out.iter().position(|c| c[0]).unwrap();
-        let settling = SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ);
+        let settling = settling_time();
         assert!((first as f64 * dt - settling).abs() < 2.0 * dt, "first detection after {} s", first as f64 * dt);
     }
 
