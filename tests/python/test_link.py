@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from hexadyn import Results, _core
 from hexadyn.cli import cli
 from hexadyn.link import LOOPBACK
-from hexadyn.link.packets import COMMAND_SIZE, REPLY_SIZE, MotorCommands, PacketError, SlaveReply, crc8_autosar, crc16_ibm3740
+from hexadyn.link.packets import COMMAND_SIZE, REPLY_SIZE, SERVO_VERSION, MotorCommands, PacketError, ServoCommands, SlaveReply, crc8_autosar, crc16_ibm3740
 
 from conftest import shortened
 
@@ -52,6 +52,38 @@ def test_python_mirror_encodes_byte_identically_to_the_engine():
         assert SlaveReply.decode(data) == r
 
 
+def test_servo_packets_mirror_the_engine_and_are_not_motor_packets():
+    rng = random.Random(7)
+    for _ in range(3000):
+        c = ServoCommands(rng.randrange(1 << 16), tuple(rng.randrange(1 << 12) for _ in range(18)))
+        data = c.encode()
+        assert data == _core.encode_command(c.seq, list(c.words), SERVO_VERSION)
+        assert ServoCommands.decode(data) == c and _core.decode_command(data, SERVO_VERSION) == (c.seq, list(c.words))
+        with pytest.raises(PacketError) as e:
+            MotorCommands.decode(data)
+        assert e.value.kind == "version"
+        with pytest.raises(ValueError, match="protocol version 2, this side speaks 1"):
+            _core.decode_command(data)
+        r = SlaveReply(rng.randrange(6), rng.randrange(1 << 16), tuple(rng.randrange(2048) for _ in range(3)), tuple(rng.randint(-25000, 25000) for _ in range(3)), rng.randrange(256))
+        data = r.encode(SERVO_VERSION)
+        assert data == _core.encode_reply(r.leg, r.seq, list(r.counts), list(r.currents_ma), r.supply, SERVO_VERSION)
+        assert SlaveReply.decode(data, SERVO_VERSION) == r
+        assert _core.decode_reply(data, SERVO_VERSION) == (r.leg, r.seq, list(r.counts), list(r.currents_ma), r.supply)
+        with pytest.raises(PacketError) as e:
+            SlaveReply.decode(data)
+        assert e.value.kind == "version"
+    # A forged servo packet: a position beyond 11 bits, with a valid CRC.
+    data = bytearray(SlaveReply(0, 1, (0, 0, 0), (0, 0, 0), 111).encode(SERVO_VERSION))
+    data[3:6] = (4096).to_bytes(3, "little")
+    data[-1] = crc8_autosar(bytes(data[:-1]))
+    with pytest.raises(PacketError) as e:
+        SlaveReply.decode(bytes(data), SERVO_VERSION)
+    assert e.value.kind == "range"
+    with pytest.raises(ValueError, match="position count = 4096 out of range"):
+        _core.decode_reply(bytes(data), SERVO_VERSION)
+    assert ServoCommands.goal(512) == 0xA00
+
+
 def test_both_sides_reject_the_same_datagrams_for_the_same_reason():
     rng = random.Random(5)
     kinds = {"size": "bytes, expected", "checksum": "corrupted", "version": "protocol version", "range": "range"}
@@ -79,8 +111,9 @@ def free_udp_port() -> int:
         return s.getsockname()[1]
 
 
-def test_robot_run_against_robot_emulate_on_loopback(tmp_path):
-    scenario = shortened("stand_six_legs", tmp_path, 1.0)
+@pytest.mark.parametrize("name, joint", [("stand_six_legs", "q_v"), ("phantomx_stand", "femur")])
+def test_robot_run_against_robot_emulate_on_loopback(tmp_path, name, joint):
+    scenario = shortened(name, tmp_path, 1.0)
     text = LOOPBACK.read_text()
     text = text.replace("127.0.0.1:47100", f"127.0.0.1:{free_udp_port()}").replace("127.255.255.255:47101", f"127.255.255.255:{free_udp_port()}")
     # The test machine is shared: a late packet or a descheduled controller now and then must
@@ -112,8 +145,10 @@ def test_robot_run_against_robot_emulate_on_loopback(tmp_path):
     assert len(ts) == 101 + missed and ts.index[-1] == pytest.approx(1.0 + 0.01 * missed)
     assert results.summary["safety_stop"] == "none"
     assert results.units["lateness"] == "s" and (ts["lateness"] >= 0).all()
-    # Standing: the PI loops hold the joints within a few encoder counts of their references.
-    assert (ts["q_v[0]"] - ts["q_v_ref[0]"]).abs().max() < 1e-4
+    # Standing: the PI loops hold the joints within a few encoder counts of their references; the
+    # AX-12A servos within 2 degrees (their compliance law under the body's weight: 1 degree).
+    tolerance = 1e-4 if joint == "q_v" else 0.035
+    assert (ts[f"{joint}[0]"] - ts[f"{joint}_ref[0]"]).abs().max() < tolerance
     assert (out / "power.csv").is_file() and (out / "energy.csv").is_file()
 
 

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use hexadyn::link::emulator::{Emulator, EmulatorOptions};
 use hexadyn::link::faults::Faults;
-use hexadyn::link::protocol::{Duty, MotorCommands, SlaveReply};
+use hexadyn::link::protocol::{Commands, Duty, Goal, MotorCommands, Protocol, ServoCommands, Setpoint, SlaveReply, COMMAND_SIZE};
 use hexadyn::link::run::spawn_robot_run;
 use hexadyn::link::LinkConfig;
 use numpy::PyArray1;
@@ -28,33 +28,59 @@ fn config(path: &PathBuf) -> PyResult<LinkConfig> {
     LinkConfig::from_file(path).map_err(value_error)
 }
 
-/// The 36-byte command packet of sequence number `seq` with 18 signed duties (-1023..1023).
-#[pyfunction]
-pub fn encode_command<'py>(py: Python<'py>, seq: u16, duties: Vec<i16>) -> PyResult<Bound<'py, PyBytes>> {
-    let duties: Vec<Duty> = duties.iter().map(|&d| Duty::new(d).ok_or_else(|| value_error(format!("duty {d}: allowed -1023..1023")))).collect::<PyResult<_>>()?;
-    let duties: [Duty; 18] = duties.try_into().map_err(|d: Vec<Duty>| value_error(format!("{} duties: allowed 18", d.len())))?;
-    Ok(PyBytes::new(py, &MotorCommands { seq, duties }.encode()))
+/// The protocol of version 1 (motor duties) or 2 (servo goals).
+fn protocol(version: u8) -> PyResult<Protocol> {
+    match version {
+        1 => Ok(Protocol::Motors),
+        2 => Ok(Protocol::Servos),
+        v => Err(value_error(format!("protocol version {v}: allowed 1 (motor duties) or 2 (servo goals)"))),
+    }
 }
 
-/// Decodes a command packet: (seq, duties); ValueError naming why it is rejected.
-#[pyfunction]
-pub fn decode_command(data: &[u8]) -> PyResult<(u16, Vec<i16>)> {
-    let c = MotorCommands::decode(data).map_err(value_error)?;
-    Ok((c.seq, c.duties.iter().map(|d| d.get()).collect()))
+fn command_bytes<S: Setpoint>(seq: u16, setpoints: Vec<S>) -> PyResult<[u8; COMMAND_SIZE]> {
+    let setpoints: [S; 18] = setpoints.try_into().map_err(|d: Vec<S>| value_error(format!("{} setpoints: allowed 18", d.len())))?;
+    Ok(Commands { seq, setpoints }.encode())
 }
 
-/// The 20-byte slave packet (fields saturated to their ranges as a board's counters and A/D
-/// converters are; `leg` modulo 6).
+/// The 36-byte command packet of sequence number `seq` with 18 setpoints: signed duties
+/// (-1023..1023) for `version` 1, servo command words (bits 0-10 the goal register, bit 11 the
+/// torque enable: 0..4095) for version 2.
 #[pyfunction]
-pub fn encode_reply<'py>(py: Python<'py>, leg: u8, seq: u16, counts: [i32; 3], currents_ma: [i16; 3], supply: u8) -> Bound<'py, PyBytes> {
-    PyBytes::new(py, &SlaveReply { leg, seq, counts, currents_ma, supply }.encode())
+#[pyo3(signature = (seq, setpoints, version = 1))]
+pub fn encode_command<'py>(py: Python<'py>, seq: u16, setpoints: Vec<i32>, version: u8) -> PyResult<Bound<'py, PyBytes>> {
+    let bytes = match protocol(version)? {
+        Protocol::Motors => command_bytes(seq, setpoints.iter().map(|&d| i16::try_from(d).ok().and_then(Duty::new).ok_or_else(|| value_error(format!("duty {d}: allowed -1023..1023")))).collect::<PyResult<_>>()?)?,
+        Protocol::Servos => command_bytes(seq, setpoints.iter().map(|&w| u16::try_from(w).ok().filter(|&w| w < 1 << 12).and_then(|w| Goal::from_word(w).ok()).ok_or_else(|| value_error(format!("servo word {w}: allowed 0..4095")))).collect::<PyResult<_>>()?)?,
+    };
+    Ok(PyBytes::new(py, &bytes))
 }
 
-/// Decodes a slave packet: (leg, seq, counts, currents_ma, supply); ValueError naming why it is
-/// rejected.
+/// Decodes a command packet of `version`: (seq, setpoints as in `encode_command`); ValueError
+/// naming why it is rejected.
 #[pyfunction]
-pub fn decode_reply(data: &[u8]) -> PyResult<(u8, u16, [i32; 3], [i16; 3], u8)> {
-    let r = SlaveReply::decode(data).map_err(value_error)?;
+#[pyo3(signature = (data, version = 1))]
+pub fn decode_command(data: &[u8], version: u8) -> PyResult<(u16, Vec<i32>)> {
+    match protocol(version)? {
+        Protocol::Motors => MotorCommands::decode(data).map(|c| (c.seq, c.setpoints.iter().map(|d| i32::from(d.get())).collect())),
+        Protocol::Servos => ServoCommands::decode(data).map(|c| (c.seq, c.setpoints.iter().map(|g| i32::from(g.bits())).collect())),
+    }
+    .map_err(value_error)
+}
+
+/// The 20-byte slave packet of `version` (fields saturated to their ranges as a board's
+/// counters and A/D converters are; `leg` modulo 6).
+#[pyfunction]
+#[pyo3(signature = (leg, seq, counts, currents_ma, supply, version = 1))]
+pub fn encode_reply<'py>(py: Python<'py>, leg: u8, seq: u16, counts: [i32; 3], currents_ma: [i16; 3], supply: u8, version: u8) -> PyResult<Bound<'py, PyBytes>> {
+    Ok(PyBytes::new(py, &SlaveReply { leg, seq, counts, currents_ma, supply }.encode(protocol(version)?)))
+}
+
+/// Decodes a slave packet of `version`: (leg, seq, counts, currents_ma, supply); ValueError
+/// naming why it is rejected.
+#[pyfunction]
+#[pyo3(signature = (data, version = 1))]
+pub fn decode_reply(data: &[u8], version: u8) -> PyResult<(u8, u16, [i32; 3], [i16; 3], u8)> {
+    let r = SlaveReply::decode(data, protocol(version)?).map_err(value_error)?;
     Ok((r.leg, r.seq, r.counts, r.currents_ma, r.supply))
 }
 

@@ -15,10 +15,11 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use hexadyn::control::Encoder;
-use hexadyn::hexapod::{PantographJoint, JOINTS};
+use hexadyn::hexapod::JOINTS;
+use hexadyn::link::drive::JointScale;
 use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
 use hexadyn::link::faults::Faults;
-use hexadyn::link::run::{run_robot, RobotRun};
+use hexadyn::link::run::{check, run_robot, RobotRun};
 use hexadyn::link::{LinkConfig, LinkError, StopReason};
 use hexadyn::scenario::{run_scenario, Override, Scenario};
 
@@ -58,6 +59,7 @@ fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRu
 /// the controller.
 fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) {
     let encoders: [Encoder; JOINTS] = s.model().encoders;
+    let protocol = check(s, &LinkConfig::loopback(0)).expect("a linked scenario");
     let periods = run.series.values("period").expect("period column");
     for (row, &p) in periods.iter().enumerate() {
         if run.series.values("last_reply").expect("last_reply")[row].is_nan() {
@@ -65,9 +67,9 @@ fn assert_rows_are_fresh(s: &Scenario, run: &RobotRun, report: &EmulatorReport) 
         }
         let latched = report.history.iter().find(|h| u64::from(h.seq) == p as u64).unwrap_or_else(|| panic!("period {p} was never applied by the emulator"));
         for (k, enc) in encoders.iter().enumerate() {
-            let name = format!("{}[{}]", PantographJoint::ALL[k % 3].symbol(), k / 3);
+            let name = s.robot.joints().column("", k, "");
             let seen = run.series.values(&name).expect("position column")[row];
-            assert_eq!(seen, f64::from(latched.counts[k]) * enc.resolution(), "row {row} (period {p}), {name}");
+            assert_eq!(seen, JointScale::new(protocol, *enc).position(latched.counts[k]), "row {row} (period {p}), {name}");
         }
     }
 }
@@ -122,10 +124,10 @@ fn a_silent_slave_stops_the_robot_within_3_periods_at_0_v() {
     let last = report.history.last().expect("commands");
     // The last command the robot applied is the stop: every motor at 0 V, three periods after
     // the first unanswered command; nothing came after it.
-    assert!(last.duties.iter().all(|d| d.get() == 0), "{:?}", last.duties);
+    assert!(last.setpoints.iter().all(|&d| d == 0), "{:?}", last.setpoints);
     assert_eq!(u64::from(last.seq), silent_from + 3);
     assert_eq!(report.commands, silent_from + 4);
-    assert!(report.history[..report.history.len() - 1].iter().rev().take(3).any(|h| h.duties.iter().any(|d| d.get() != 0)), "it was walking");
+    assert!(report.history[..report.history.len() - 1].iter().rev().take(3).any(|h| h.setpoints.iter().any(|&d| d != 0)), "it was walking");
     assert_rows_are_fresh(&s, &run, &report);
 }
 
@@ -167,4 +169,104 @@ fn no_slave_no_run() {
     config.timing.period = Duration::from_millis(20);
     let e = run_robot(&s, &config, |_| ControlFlow::Continue(())).expect_err("wrong period");
     assert!(e.to_string().contains("timing.period_s"), "{e}");
+}
+
+/// The final body position of the simulation and the emulated robot's distance to it (m).
+fn distance_to_simulation(s: &Scenario, report: &EmulatorReport) -> (f64, [f64; 3]) {
+    let direct = run_scenario(s, |_| {}).expect("simulation");
+    let end = ["X", "Y", "Z"].map(|c| *direct.series.values(c).expect(c).last().expect("rows"));
+    ((0..3).map(|i| (report.body[i] - end[i]).powi(2)).sum::<f64>().sqrt(), end)
+}
+
+/// A serial robot with position servos (PhantomX, AX-12A) through the servo variant of the
+/// packets, the master's goals and the boards' present positions in whole registers: standing,
+/// the emulated robot ends within 1 mm of the simulation; walking 3 s (15 cm), within 2 mm:
+/// the simulation's goals are not whole registers (0.29°), and the servos' stick-slip at every
+/// swing and support carries such differences on.
+#[test]
+fn phantomx_stand_and_tripod_through_master_and_emulator_end_near_the_simulation() {
+    for (name, duration, tolerance) in [("phantomx_stand", 2.0, 1e-3), ("phantomx_tripod", 3.0, 2e-3)] {
+        let s = scenario(name, duration);
+        let (run, report) = linked(&s, Faults::default(), TOLERANT);
+        let run = run.expect("linked run");
+        assert!(run.stop.is_none(), "{name}: {:?}", run.stop);
+        assert_eq!(report.error, None);
+        assert_eq!(run.stats.rejected.total() + run.stats.wrong_leg, 0, "{name}");
+        let (d, end) = distance_to_simulation(&s, &report);
+        println!("{name}: body at {end:.4?} m in the simulation; master + emulator {:.3} mm from it ({} periods, {} missed)", d * 1e3, run.stats.broadcasts, run.stats.missed_periods);
+        assert!(d < tolerance, "{name}: {:.3} mm apart", d * 1e3);
+        assert_rows_are_fresh(&s, &run, &report);
+        // The goals are whole registers from the middle of the servo's sensor.
+        let count = 300f64.to_radians() / 1024.0;
+        let goals = run.series.values("femur_goal[2]").expect("goal column");
+        assert!(goals.iter().filter(|g| !g.is_nan()).all(|g| (g / count - (g / count).round()).abs() < 1e-9), "{name}");
+        if name == "phantomx_tripod" {
+            assert!(end[0] > 0.12, "the simulated walk covers 15 cm, got {}", end[0]);
+        }
+    }
+}
+
+/// Corrupted and wrong-size servo packets are counted exactly and never reach the controller.
+#[test]
+fn corrupted_servo_packets_are_counted_and_never_reach_the_controller() {
+    let s = scenario("phantomx_tripod", 4.0);
+    let faults = Faults { corrupt: 0.05, wrong_size: 0.03, seed: 3, ..Default::default() };
+    let (run, report) = linked(&s, faults, TOLERANT);
+    let run = run.expect("walk with corrupted packets");
+    assert!(run.stop.is_none(), "{:?}", run.stop);
+    assert!(report.faults.corrupted > 30 && report.faults.wrong_size > 20, "{:?}", report.faults);
+    assert_eq!(run.stats.rejected.checksum, report.faults.corrupted);
+    assert_eq!(run.stats.rejected.size, report.faults.wrong_size);
+    assert_eq!(run.stats.rejected.version + run.stats.rejected.range + run.stats.wrong_leg, 0);
+    assert_rows_are_fresh(&s, &run, &report);
+}
+
+/// The servo boards reject motor commands, forged and corrupted commands with a counted
+/// packet error, answer a valid servo command with servo packets only, and never panic.
+#[test]
+fn servo_boards_count_the_packets_of_the_other_kind_and_forged_ones() {
+    use hexadyn::link::protocol::{Duty, Goal, MotorCommands, PacketError, Protocol, ServoCommands, SlaveReply, COMMAND_SIZE, REPLY_SIZE};
+    let _turn = ONE_LINK_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let s = scenario("phantomx_stand", 1.0);
+    let config = LinkConfig::loopback(0);
+    let options = EmulatorOptions { idle_timeout: Some(Duration::from_secs(5)), ..Default::default() };
+    let emulator = Emulator::start(&s, &config, options).expect("emulator");
+    let to = emulator.command_address();
+    let master = std::net::UdpSocket::bind("127.0.0.1:0").expect("socket");
+    master.set_broadcast(true).expect("broadcast");
+    master.set_read_timeout(Some(Duration::from_secs(10))).expect("timeout");
+    let mut forged = ServoCommands::zero(7).encode();
+    forged[3] ^= 0x40; // a corrupted goal
+    let mut bad_header = ServoCommands::zero(8).encode();
+    bad_header[11] |= 0x10; // a reserved header nibble set: the CRC no longer matches
+    let datagrams: Vec<Vec<u8>> = vec![
+        MotorCommands { seq: 1, setpoints: [Duty::new(300).unwrap(); JOINTS] }.encode().to_vec(),
+        forged.to_vec(),
+        bad_header.to_vec(),
+        vec![0; COMMAND_SIZE - 1],
+        vec![0xFF; COMMAND_SIZE + 3],
+    ];
+    for d in &datagrams {
+        master.send_to(d, to).expect("send");
+    }
+    // Then a valid command: its six answers come after the forged ones were handled.
+    let goals = ServoCommands { seq: 9, setpoints: [Goal::position(512).unwrap(); JOINTS] };
+    master.send_to(&goals.encode(), to).expect("send");
+    let mut legs = Vec::new();
+    let mut buf = [0u8; 64];
+    while legs.len() < 6 {
+        let (n, _) = master.recv_from(&mut buf).expect("the six servo packets");
+        assert_eq!(n, REPLY_SIZE);
+        assert_eq!(SlaveReply::decode(&buf[..n], Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
+        let r = SlaveReply::decode(&buf[..n], Protocol::Servos).expect("a servo packet");
+        assert_eq!(r.seq, 9);
+        // Standing near the joint zero's middle register.
+        assert!(r.counts.iter().all(|&c| (0..1024).contains(&c)), "{r:?}");
+        legs.push(r.leg);
+    }
+    let report = emulator.stop();
+    assert_eq!(report.commands, 1);
+    assert_eq!((report.rejected.version, report.rejected.checksum, report.rejected.size), (1, 2, 2), "{:?}", report.rejected);
+    legs.sort_unstable();
+    assert_eq!(legs, [0, 1, 2, 3, 4, 5]);
 }

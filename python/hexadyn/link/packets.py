@@ -10,6 +10,9 @@ size, CRC, version, ranges. For tools and tests: sniffing, replaying, writing a 
   4 reserved bytes). CRC-16/IBM-3740 over the 36 bytes with its own nibbles (words 6-9) as 0.
 - Slave packet, 20 bytes: version << 4 | leg; sequence number u16; three signed 24-bit encoder
   counts; three i16 currents (mA); supply u8 (0.1 V); CRC-8/AUTOSAR of bytes 0-18.
+- Servo variant, protocol version 2 (position servos): command word bits 0-10 a goal register
+  (0..2047), bit 11 the torque enable; the slave packet's 24-bit fields the present positions
+  (0..2047), its currents the servos' present currents.
 """
 
 from __future__ import annotations
@@ -18,6 +21,9 @@ import struct
 from dataclasses import dataclass
 
 PROTOCOL_VERSION = 1
+#: Protocol version of the servo variant.
+SERVO_VERSION = 2
+GOAL_MAX = 0x07FF
 COMMAND_SIZE = 36
 REPLY_SIZE = 20
 JOINTS = 18
@@ -30,11 +36,12 @@ SUPPLY_LSB_V = 0.1
 
 _DIRECTION_BIT = 1 << 10
 _RESERVED_BIT = 1 << 11
+_TORQUE_BIT = 1 << 11
 _HEADER_BYTES = JOINTS // 2
 _HEADER_SEQ, _HEADER_VERSION, _HEADER_CRC = 0, 2, 3
 _CRC_WORDS = (6, 7, 8, 9)
 
-__all__ = ["PacketError", "MotorCommands", "SlaveReply", "crc8_autosar", "crc16_ibm3740", "COMMAND_SIZE", "REPLY_SIZE", "PROTOCOL_VERSION"]
+__all__ = ["PacketError", "MotorCommands", "ServoCommands", "SlaveReply", "SERVO_VERSION", "crc8_autosar", "crc16_ibm3740", "COMMAND_SIZE", "REPLY_SIZE", "PROTOCOL_VERSION"]
 
 
 def _crc_table(poly: int, width: int) -> list[int]:
@@ -83,6 +90,43 @@ def _command_crc(data: bytes) -> int:
     return crc16_ibm3740(bytes(b))
 
 
+def _encode_command(seq: int, bits: list[int], version: int) -> bytes:
+    """The command packet of `version` with the 12 setpoint bits of each word."""
+    header = bytearray(_HEADER_BYTES)
+    header[_HEADER_SEQ : _HEADER_SEQ + 2] = seq.to_bytes(2, "little")
+    header[_HEADER_VERSION] = version
+    words = [b | ((header[k // 2] >> (4 * (k % 2))) & 0x0F) << 12 for k, b in enumerate(bits)]
+    data = bytearray(struct.pack("<18H", *words))
+    crc = _command_crc(bytes(data))
+    for i, w in enumerate(_CRC_WORDS):
+        data[2 * w + 1] = (data[2 * w + 1] & 0x0F) | ((crc >> (4 * i)) & 0x0F) << 4
+    return bytes(data)
+
+
+def _decode_command(data: bytes, version: int) -> tuple[int, tuple[int, ...]]:
+    """(seq, the 18 words) of a command packet of `version`, checked as the engine checks it."""
+    if len(data) != COMMAND_SIZE:
+        raise PacketError("size", f"{len(data)} bytes, expected {COMMAND_SIZE}")
+    words = struct.unpack("<18H", data)
+    header = bytearray(_HEADER_BYTES)
+    for k, w in enumerate(words):
+        header[k // 2] |= (w >> 12) << (4 * (k % 2))
+    computed = _command_crc(data)
+    received = int.from_bytes(header[_HEADER_CRC : _HEADER_CRC + 2], "little")
+    if computed != received:
+        raise PacketError("checksum", f"CRC {received:#06x} does not match the content ({computed:#06x}): corrupted")
+    if header[_HEADER_VERSION] != version:
+        raise PacketError("version", f"protocol version {header[_HEADER_VERSION]}, this side speaks {version}")
+    if any(header[_HEADER_CRC + 2 :]):
+        raise PacketError("range", "command header bytes 5-8 (reserved) are not 0")
+    return int.from_bytes(header[_HEADER_SEQ : _HEADER_SEQ + 2], "little"), words
+
+
+def _check_seq(seq: int) -> None:
+    if not 0 <= seq <= 0xFFFF:
+        raise ValueError(f"seq = {seq}: allowed 0..65535")
+
+
 @dataclass(frozen=True)
 class MotorCommands:
     """A command packet: the period's sequence number and the 18 signed duties (-1023..1023)."""
@@ -91,43 +135,45 @@ class MotorCommands:
     duties: tuple[int, ...]
 
     def encode(self) -> bytes:
-        if not 0 <= self.seq <= 0xFFFF:
-            raise ValueError(f"seq = {self.seq}: allowed 0..65535")
+        _check_seq(self.seq)
         if len(self.duties) != JOINTS or any(abs(d) > DUTY_MAX for d in self.duties):
             raise ValueError(f"duties = {self.duties}: allowed 18 integers in -1023..1023")
-        header = bytearray(_HEADER_BYTES)
-        header[_HEADER_SEQ : _HEADER_SEQ + 2] = self.seq.to_bytes(2, "little")
-        header[_HEADER_VERSION] = PROTOCOL_VERSION
-        words = []
-        for k, d in enumerate(self.duties):
-            nibble = (header[k // 2] >> (4 * (k % 2))) & 0x0F
-            words.append(abs(d) | (_DIRECTION_BIT if d < 0 else 0) | nibble << 12)
-        data = bytearray(struct.pack("<18H", *words))
-        crc = _command_crc(bytes(data))
-        for i, w in enumerate(_CRC_WORDS):
-            data[2 * w + 1] = (data[2 * w + 1] & 0x0F) | ((crc >> (4 * i)) & 0x0F) << 4
-        return bytes(data)
+        return _encode_command(self.seq, [abs(d) | (_DIRECTION_BIT if d < 0 else 0) for d in self.duties], PROTOCOL_VERSION)
 
     @classmethod
     def decode(cls, data: bytes) -> "MotorCommands":
-        if len(data) != COMMAND_SIZE:
-            raise PacketError("size", f"{len(data)} bytes, expected {COMMAND_SIZE}")
-        words = struct.unpack("<18H", data)
-        header = bytearray(_HEADER_BYTES)
-        for k, w in enumerate(words):
-            header[k // 2] |= (w >> 12) << (4 * (k % 2))
-        computed = _command_crc(data)
-        received = int.from_bytes(header[_HEADER_CRC : _HEADER_CRC + 2], "little")
-        if computed != received:
-            raise PacketError("checksum", f"CRC {received:#06x} does not match the content ({computed:#06x}): corrupted")
-        if header[_HEADER_VERSION] != PROTOCOL_VERSION:
-            raise PacketError("version", f"protocol version {header[_HEADER_VERSION]}, this side speaks {PROTOCOL_VERSION}")
-        if any(header[_HEADER_CRC + 2 :]):
-            raise PacketError("range", "command header bytes 5-8 (reserved) are not 0")
+        seq, words = _decode_command(data, PROTOCOL_VERSION)
         if any(w & _RESERVED_BIT for w in words):
             raise PacketError("range", "command word bit 11 (reserved) is set")
         duties = tuple(-(w & DUTY_MAX) if w & _DIRECTION_BIT else w & DUTY_MAX for w in words)
-        return cls(int.from_bytes(header[_HEADER_SEQ : _HEADER_SEQ + 2], "little"), duties)
+        return cls(seq, duties)
+
+
+@dataclass(frozen=True)
+class ServoCommands:
+    """A servo command packet (version 2): the sequence number and 18 servo words, bits 0-10 the
+    goal register (0..2047), bit 11 the torque enable (0: torque off, the goal ignored)."""
+
+    seq: int
+    words: tuple[int, ...]
+
+    @staticmethod
+    def goal(register: int) -> int:
+        """The word holding `register` (0..2047) with the torque on."""
+        if not 0 <= register <= GOAL_MAX:
+            raise ValueError(f"goal register {register}: allowed 0..2047")
+        return register | _TORQUE_BIT
+
+    def encode(self) -> bytes:
+        _check_seq(self.seq)
+        if len(self.words) != JOINTS or any(not 0 <= w <= 0x0FFF for w in self.words):
+            raise ValueError(f"words = {self.words}: allowed 18 integers in 0..4095")
+        return _encode_command(self.seq, list(self.words), SERVO_VERSION)
+
+    @classmethod
+    def decode(cls, data: bytes) -> "ServoCommands":
+        seq, words = _decode_command(data, SERVO_VERSION)
+        return cls(seq, tuple(w & 0x0FFF for w in words))
 
 
 @dataclass(frozen=True)
@@ -146,12 +192,14 @@ class SlaveReply:
         """Supply voltage (V), exactly as the engine computes it (supply / 10)."""
         return self.supply / 10.0
 
-    def encode(self) -> bytes:
+    def encode(self, version: int = PROTOCOL_VERSION) -> bytes:
+        """The packet of `version` (1: encoder counts; 2: servo positions 0..2047)."""
+        low, high = _count_range(version)
         if not 0 <= self.leg < 6 or not 0 <= self.seq <= 0xFFFF or not 0 <= self.supply <= 255:
             raise ValueError(f"leg = {self.leg}, seq = {self.seq}, supply = {self.supply}: allowed 0..5, 0..65535, 0..255")
-        if any(not COUNT_MIN <= c <= COUNT_MAX for c in self.counts) or any(abs(i) > CURRENT_MAX_MA for i in self.currents_ma):
-            raise ValueError(f"counts = {self.counts}, currents = {self.currents_ma} mA: allowed signed 24-bit counts, |i| <= 25000 mA")
-        data = bytearray([PROTOCOL_VERSION << 4 | self.leg]) + self.seq.to_bytes(2, "little")
+        if any(not low <= c <= high for c in self.counts) or any(abs(i) > CURRENT_MAX_MA for i in self.currents_ma):
+            raise ValueError(f"counts = {self.counts}, currents = {self.currents_ma} mA: allowed counts {low}..{high}, |i| <= 25000 mA")
+        data = bytearray([version << 4 | self.leg]) + self.seq.to_bytes(2, "little")
         for c in self.counts:
             data += (c & 0xFFFFFF).to_bytes(3, "little")
         data += struct.pack("<3hB", *self.currents_ma, self.supply)
@@ -159,19 +207,31 @@ class SlaveReply:
         return bytes(data)
 
     @classmethod
-    def decode(cls, data: bytes) -> "SlaveReply":
+    def decode(cls, data: bytes, version: int = PROTOCOL_VERSION) -> "SlaveReply":
+        low, high = _count_range(version)
         if len(data) != REPLY_SIZE:
             raise PacketError("size", f"{len(data)} bytes, expected {REPLY_SIZE}")
         computed = crc8_autosar(data[:-1])
         if computed != data[-1]:
             raise PacketError("checksum", f"CRC {data[-1]:#06x} does not match the content ({computed:#06x}): corrupted")
-        version, leg = data[0] >> 4, data[0] & 0x0F
-        if version != PROTOCOL_VERSION:
-            raise PacketError("version", f"protocol version {version}, this side speaks {PROTOCOL_VERSION}")
+        leg = data[0] & 0x0F
+        if data[0] >> 4 != version:
+            raise PacketError("version", f"protocol version {data[0] >> 4}, this side speaks {version}")
         if leg >= 6:
             raise PacketError("range", f"leg = {leg} out of range; allowed: 0..5")
         counts = tuple(int.from_bytes(data[3 + 3 * j : 6 + 3 * j], "little", signed=True) for j in range(3))
+        if any(not low <= c <= high for c in counts):
+            raise PacketError("range", f"position count = {counts} out of range; allowed: {low}..{high}")
         *currents, supply = struct.unpack("<3hB", data[12:19])
         if any(abs(i) > CURRENT_MAX_MA for i in currents):
             raise PacketError("range", f"motor current (mA) = {currents} out of range; allowed: -25000..25000")
         return cls(leg, int.from_bytes(data[1:3], "little"), counts, tuple(currents), supply)
+
+
+def _count_range(version: int) -> tuple[int, int]:
+    """The range of a slave packet's position counts in `version`."""
+    if version == PROTOCOL_VERSION:
+        return COUNT_MIN, COUNT_MAX
+    if version == SERVO_VERSION:
+        return 0, GOAL_MAX
+    raise ValueError(f"protocol version {version}: allowed 1 (motor duties) or 2 (servo goals)")

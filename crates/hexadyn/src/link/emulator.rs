@@ -2,11 +2,12 @@
 //! controller without the robot.
 //!
 //! Each command packet is handled as a board does (Section 2.3.2, Fig. 2.19): the boards apply
-//! the 18 duties and latch what they measure at that instant — the encoder counts (500 per
-//! motor revolution), the motor currents and the supply voltage of the simulated AMRU5 — then
+//! the 18 duties (with servos, the 18 goals: [`super::drive`]) and latch what they measure at
+//! that instant — the encoder counts (500 per motor revolution on AMRU5; with servos, their
+//! present positions), the motor currents and the supply voltage of the simulated robot — then
 //! the slave of leg l sends its packet t_s0 + l Δt_s after the broadcast (2.5 ms + l × 0.5 ms,
 //! Figs. 2.21-2.22) to the address the command came from. Meanwhile the multiphysics model
-//! advances one control period with the applied voltages (duty / 1023 × its supply). The
+//! advances one control period with the applied voltages (duty / 1023 × its supply) or goals. The
 //! currents are those at the end of the previous period (the model has no time between the
 //! PWM update and the A/D conversion).
 //!
@@ -31,10 +32,11 @@ use std::time::{Duration, Instant};
 
 use super::clock::{realtime_thread, sleep_until, Percentiles};
 use super::config::LinkConfig;
+use super::drive::{Drive, JointScale};
 use super::faults::{FaultCounts, FaultInjector, Faults, Outgoing};
-use super::protocol::{seq_distance, Duty, MotorCommands, PacketErrorCounts, SlaveReply};
+use super::protocol::{seq_distance, Commands, Duty, Goal, PacketErrorCounts, Protocol, Setpoint, SlaveReply};
 use super::LinkError;
-use crate::control::{Command, Encoder, Plant};
+use crate::control::{Command, Plant};
 use crate::hexapod::{JOINTS, LEG_COUNT};
 use crate::robot::simulation::SimulatedRobot;
 use crate::scenario::{settled_robot, Scenario};
@@ -58,8 +60,9 @@ pub struct EmulatorOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct EmulatedPeriod {
     pub seq: u16,
-    pub duties: [Duty; JOINTS],
-    /// The encoder counts latched, joint k = 3 leg + j.
+    /// The setpoint bits of each command word (bits 0-11; all 0: the zero command).
+    pub setpoints: [u16; JOINTS],
+    /// The position counts latched (encoder counts, or servo positions), joint k = 3 leg + j.
     pub counts: [i32; JOINTS],
     /// The body pose X, Y, Z, yaw, pitch, roll of the simulated robot at the latch.
     pub body: [f64; 6],
@@ -108,7 +111,7 @@ impl Emulator {
     /// slave sockets, and starts answering.
     pub fn start(s: &Scenario, config: &LinkConfig, options: EmulatorOptions) -> Result<Emulator, LinkError> {
         options.faults.validate().map_err(LinkError::Emulator)?;
-        super::run::check_robot(s)?;
+        let protocol = super::run::check_robot(s)?;
         let robot = settled_robot(s)?;
         let socket_error = |what, address: String| move |source| LinkError::Socket { what, address, source };
         let commands = UdpSocket::bind(config.broadcast).map_err(socket_error("cannot listen for the commands on", config.broadcast.to_string()))?;
@@ -130,18 +133,11 @@ impl Emulator {
                 send_loop(&slaves, &queue, &stop_sender)
             })
             .map_err(|e| LinkError::Emulator(format!("cannot start the sender thread: {e}")))?;
-        let stop_model = stop.clone();
-        let encoders = robot.robot.model.encoders;
-        let model = std::thread::Builder::new()
-            .name("hexadyn-emulator".into())
-            .spawn(move || {
-                // Below the sender: a long model period must not delay the packets.
-                let realtime = realtime_thread(timing.realtime_priority.map(|p| p.saturating_sub(1).max(1)));
-                let mut e = Slaves { robot, encoders, faults: FaultInjector::new(options.faults.clone()), report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new() };
-                e.serve(&commands, &jobs, &stop_model, options.idle_timeout);
-                e.finish()
-            })
-            .map_err(|e| LinkError::Emulator(format!("cannot start the emulator thread: {e}")))?;
+        let model = match protocol {
+            Protocol::Motors => spawn_model::<Duty>(robot, s.initial.joints, commands, jobs, stop.clone(), timing, options),
+            Protocol::Servos => spawn_model::<Goal>(robot, s.initial.joints, commands, jobs, stop.clone(), timing, options),
+        }
+        .map_err(|e| LinkError::Emulator(format!("cannot start the emulator thread: {e}")))?;
         Ok(Emulator { stop, model: Some(model), sender: Some(sender), command_address })
     }
 
@@ -199,10 +195,28 @@ struct Job {
     bytes: Vec<u8>,
 }
 
-/// The model side: commands in, latched packets out, one model period per command.
-struct Slaves {
+/// Starts the model thread of the boards of setpoints `S`; servos hold the joint positions
+/// `initial` (the posture the robot settled in) until their first goals.
+#[allow(clippy::too_many_arguments)]
+fn spawn_model<S: Drive>(robot: SimulatedRobot, initial: [f64; JOINTS], commands: UdpSocket, jobs: Sender<Job>, stop: Arc<AtomicBool>, timing: super::config::Timing, options: EmulatorOptions) -> std::io::Result<JoinHandle<EmulatorReport>> {
+    std::thread::Builder::new().name("hexadyn-emulator".into()).spawn(move || {
+        // Below the sender: a long model period must not delay the packets.
+        let realtime = realtime_thread(timing.realtime_priority.map(|p| p.saturating_sub(1).max(1)));
+        let scales = robot.robot.model.encoders.map(|e| JointScale::new(S::PROTOCOL, e));
+        let applied = Command { goals: robot.robot.model.takes_references().then_some(initial), references: initial, ..Default::default() };
+        let mut e = Slaves::<S> { robot, scales, applied, faults: FaultInjector::new(options.faults.clone()), report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new(), kind: std::marker::PhantomData };
+        e.serve(&commands, &jobs, &stop, options.idle_timeout);
+        e.finish()
+    })
+}
+
+/// The model side: commands of setpoints `S` in, latched packets out, one model period per
+/// command.
+struct Slaves<S> {
     robot: SimulatedRobot,
-    encoders: [Encoder; JOINTS],
+    scales: [JointScale; JOINTS],
+    /// The command the boards apply to the simulated robot (a servo turned off keeps its goal).
+    applied: Command,
     faults: FaultInjector,
     report: EmulatorReport,
     last_seq: Option<u16>,
@@ -210,9 +224,10 @@ struct Slaves {
     history: bool,
     /// Wall time of each model period (s).
     step_times: Vec<f64>,
+    kind: std::marker::PhantomData<S>,
 }
 
-impl Slaves {
+impl<S: Drive> Slaves<S> {
     fn serve(&mut self, socket: &UdpSocket, jobs: &Sender<Job>, stop: &AtomicBool, idle_timeout: Option<Duration>) {
         let mut buf = [0u8; 2048];
         let mut last_command: Option<Instant> = None;
@@ -233,7 +248,7 @@ impl Slaves {
                 }
             };
             let received = Instant::now();
-            let command = match MotorCommands::decode(&buf[..n]) {
+            let command = match Commands::<S>::decode(&buf[..n]) {
                 Ok(c) => c,
                 Err(e) => {
                     self.report.rejected.count(&e);
@@ -256,29 +271,33 @@ impl Slaves {
     }
 
     /// Latches and schedules the six packets, then advances the model with the command.
-    fn apply(&mut self, command: &MotorCommands, received: Instant, to: SocketAddr, jobs: &Sender<Job>) -> Result<(), String> {
+    fn apply(&mut self, command: &Commands<S>, received: Instant, to: SocketAddr, jobs: &Sender<Job>) -> Result<(), String> {
         self.last_seq = Some(command.seq);
         let state = self.robot.state();
         let q = state.q.as_slice();
-        let counts: [i64; JOINTS] = std::array::from_fn(|k| self.encoders[k].counts(q[6 + k]));
+        let counts: [i64; JOINTS] = std::array::from_fn(|k| self.scales[k].count(q[6 + k]));
         let currents = self.robot.robot.outputs.current;
         let supply = self.robot.robot.model.options.supply_voltage;
         let n = self.report.commands;
-        for leg in 0..LEG_COUNT {
+        let replies: [SlaveReply; LEG_COUNT] = std::array::from_fn(|leg| {
             let j = 3 * leg;
-            let packet = SlaveReply::measured(leg, command.seq, [counts[j], counts[j + 1], counts[j + 2]], [currents[j], currents[j + 1], currents[j + 2]], supply).encode();
-            for Outgoing { leg, delay, bytes } in self.faults.apply(leg, n, self.timing.reply_delay(leg), &packet) {
+            SlaveReply::measured(S::PROTOCOL, leg, command.seq, [counts[j], counts[j + 1], counts[j + 2]], [currents[j], currents[j + 1], currents[j + 2]], supply)
+        });
+        for (leg, reply) in replies.iter().enumerate() {
+            for Outgoing { leg, delay, bytes } in self.faults.apply(leg, n, self.timing.reply_delay(leg), &reply.encode(S::PROTOCOL)) {
                 // The sender outlives this thread unless it failed; then packets are moot.
                 let _ = jobs.send(Job { due: received + delay, leg, to, bytes });
             }
         }
         if self.history {
             let body = std::array::from_fn(|i| q[i]);
-            let counts = counts.map(|c| c.clamp(i64::from(super::protocol::COUNT_MIN), i64::from(super::protocol::COUNT_MAX)) as i32);
-            self.report.history.push(EmulatedPeriod { seq: command.seq, duties: command.duties, counts, body, t: state.t });
+            let counts = std::array::from_fn(|k| replies[k / 3].counts[k % 3]);
+            self.report.history.push(EmulatedPeriod { seq: command.seq, setpoints: command.setpoints.map(Setpoint::bits), counts, body, t: state.t });
         }
-        let voltages = command.duties.map(|d| d.voltage(supply));
-        self.robot.actuate(&Command { voltages, references: [0.0; JOINTS], goals: None });
+        for (k, setpoint) in command.setpoints.iter().enumerate() {
+            setpoint.apply(k, &self.scales[k], supply, &mut self.applied);
+        }
+        self.robot.actuate(&self.applied);
         self.report.commands += 1;
         let stepping = Instant::now();
         let stepped = self.robot.wait_period();

@@ -1,6 +1,7 @@
 //! The master side of the link: the deadline loop of Section 2.3.2 (the pseudo-code under
 //! Fig. 2.17). At each deadline of an absolute monotonic clock the master broadcasts the 18
-//! motor commands, then collects the six slave packets; the period is complete when the last
+//! setpoints (motor duties, or servo goals: the master is generic over the [`Setpoint`]), then
+//! collects the six slave packets; the period is complete when the last
 //! one arrives, and the controller runs at once (in [`super::UdpPlant`]). Waiting is precise
 //! ([`super::clock::wait_readable`]): `ppoll` up to the deadline minus a spin margin, then a
 //! spin.
@@ -11,17 +12,18 @@
 //! or out-of-order packet is never taken as fresh.
 //!
 //! Safety: a slave silent for `safety.missing_periods` periods in a row (3 by default), a
-//! controller overrun (its command not ready at the deadline) or an interrupt broadcasts 0 V
-//! to every motor and stops the run with a [`SafetyStop`]. Dropping a master that has not
+//! controller overrun (its command not ready at the deadline) or an interrupt broadcasts the
+//! zero command (0 V to every motor, every servo's torque off) and stops the run with a [`SafetyStop`]. Dropping a master that has not
 //! stopped does the same.
 
+use std::marker::PhantomData;
 use std::net::{SocketAddr, UdpSocket};
 use std::os::fd::AsRawFd;
 use std::time::{Duration, Instant};
 
 use super::clock::{wait_readable, Wake};
 use super::config::LinkConfig;
-use super::protocol::{seq_distance, Duty, MotorCommands, PacketErrorCounts, SlaveReply, COMMAND_SIZE};
+use super::protocol::{seq_distance, Commands, PacketErrorCounts, Setpoint, SlaveReply, COMMAND_SIZE};
 use super::LinkError;
 use crate::hexapod::{JOINTS, LEG_COUNT};
 
@@ -41,7 +43,7 @@ pub enum StopReason {
     Interrupted,
 }
 
-/// A safety stop: every motor was put to 0 V at `period`.
+/// A safety stop: every motor was put to 0 V (every servo's torque off) at `period`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SafetyStop {
     pub period: u64,
@@ -102,8 +104,8 @@ impl LinkStats {
     }
 }
 
-/// The master's socket, clock and per-period bookkeeping.
-pub struct Master {
+/// The master's socket, clock and per-period bookkeeping, for the packets of `S`.
+pub struct Master<S: Setpoint> {
     socket: UdpSocket,
     config: LinkConfig,
     /// Index of the current period (the last broadcast at a deadline).
@@ -117,11 +119,12 @@ pub struct Master {
     stopped: bool,
     pub stats: LinkStats,
     pub events: Vec<LinkEvent>,
+    kind: PhantomData<S>,
 }
 
-impl Master {
+impl<S: Setpoint> Master<S> {
     /// Binds the master socket (broadcast allowed); the clock starts with [`Self::start_clock`].
-    pub fn bind(config: &LinkConfig) -> Result<Master, LinkError> {
+    pub fn bind(config: &LinkConfig) -> Result<Self, LinkError> {
         let socket_error = |source| LinkError::Socket { what: "cannot open the master socket", address: config.master.to_string(), source };
         let socket = UdpSocket::bind(config.master).map_err(socket_error)?;
         socket.set_broadcast(true).map_err(socket_error)?;
@@ -140,6 +143,7 @@ impl Master {
             stopped: false,
             stats: LinkStats::default(),
             events: Vec::new(),
+            kind: PhantomData,
         })
     }
 
@@ -179,12 +183,12 @@ impl Master {
         }
     }
 
-    /// One period: waits for the deadline, broadcasts `duties`, collects the slave packets.
+    /// One period: waits for the deadline, broadcasts `setpoints`, collects the slave packets.
     /// Returns them when all six came fresh before the next deadline, `None` when some are
     /// missing; stops the robot when a slave has been missing too long.
-    pub fn run_period(&mut self, duties: &[Duty; JOINTS]) -> Result<Option<[SlaveReply; LEG_COUNT]>, LinkError> {
+    pub fn run_period(&mut self, setpoints: &[S; JOINTS]) -> Result<Option<[SlaveReply; LEG_COUNT]>, LinkError> {
         self.wait(self.next_deadline)?;
-        self.broadcast(duties)?;
+        self.broadcast(setpoints)?;
         self.collect()?;
         let mut silent = Vec::new();
         for leg in 0..LEG_COUNT {
@@ -217,13 +221,13 @@ impl Master {
         }
     }
 
-    /// The start: broadcasts 0 V every period until the six slaves answer in one period, for
+    /// The start: broadcasts the zero command every period until the six slaves answer in one period, for
     /// at most the configured connect timeout (a missing slave is no safety stop yet).
     pub fn connect(&mut self) -> Result<[SlaveReply; LEG_COUNT], LinkError> {
         let give_up = Instant::now() + self.config.safety.connect_timeout;
         loop {
             self.wait(self.next_deadline)?;
-            self.broadcast(&[Duty::ZERO; JOINTS])?;
+            self.broadcast(&[S::default(); JOINTS])?;
             self.collect()?;
             if let [Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)] = self.replies {
                 self.stats.complete_periods += 1;
@@ -248,7 +252,7 @@ impl Master {
         Ok(())
     }
 
-    /// Broadcasts 0 V to every motor at once and returns the stop as an error.
+    /// Broadcasts the zero command at once and returns the stop as an error.
     pub fn safety_stop(&mut self, reason: StopReason) -> LinkError {
         self.stop();
         let stop = SafetyStop { period: self.period, reason };
@@ -256,14 +260,15 @@ impl Master {
         LinkError::Stopped(stop)
     }
 
-    /// Puts every motor to 0 V now (the zero command sent three times, one sequence number).
+    /// Puts every motor to 0 V (every servo's torque off) now: the zero command sent three
+    /// times, one sequence number.
     pub fn stop(&mut self) {
         if self.stopped {
             return;
         }
         self.stopped = true;
         let seq = if self.started { self.period.wrapping_add(1) as u16 } else { 0 };
-        let bytes = MotorCommands::zero(seq).encode();
+        let bytes = Commands::<S>::zero(seq).encode();
         for _ in 0..STOP_REPEATS {
             if let Err(e) = self.socket.send_to(&bytes, self.config.broadcast) {
                 self.event(format!("the stop command could not be sent: {e}"));
@@ -296,11 +301,11 @@ impl Master {
         wait_readable(self.socket.as_raw_fd(), deadline, self.config.timing.spin).map_err(|source| LinkError::Socket { what: "cannot poll the master socket", address: self.config.master.to_string(), source })
     }
 
-    fn broadcast(&mut self, duties: &[Duty; JOINTS]) -> Result<(), LinkError> {
+    fn broadcast(&mut self, setpoints: &[S; JOINTS]) -> Result<(), LinkError> {
         if self.started {
             self.period += 1;
         }
-        let bytes: [u8; COMMAND_SIZE] = MotorCommands { seq: self.period as u16, duties: *duties }.encode();
+        let bytes: [u8; COMMAND_SIZE] = Commands { seq: self.period as u16, setpoints: *setpoints }.encode();
         let now = Instant::now();
         self.socket.send_to(&bytes, self.config.broadcast).map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
         let deadline = self.next_deadline;
@@ -352,7 +357,7 @@ impl Master {
             self.event(format!("{} bytes from {from}, no configured slave: dropped", bytes.len()));
             return;
         };
-        let reply = match SlaveReply::decode(bytes) {
+        let reply = match SlaveReply::decode(bytes, S::PROTOCOL) {
             Ok(r) => r,
             Err(e) => {
                 self.stats.rejected.count(&e);
@@ -381,7 +386,7 @@ impl Master {
     }
 }
 
-impl Drop for Master {
+impl<S: Setpoint> Drop for Master<S> {
     fn drop(&mut self) {
         self.stop();
     }

@@ -1,9 +1,11 @@
 //! The real-time link to the robot (thesis Section 2.3.2, Figs. 2.17-2.22): the master PC
-//! broadcasts the 18 motor commands to the six slave boards over UDP every 10 ms and collects
+//! broadcasts the 18 motor commands (or servo goals) to the six slave boards over UDP every 10 ms and collects
 //! their sensor packets; the same controller that drives the simulated robot drives the real
 //! one (architecture principle 3).
 //!
-//! - [`protocol`]: the 36-byte command and 20-byte slave packets (layout, scaling, CRC);
+//! - [`protocol`]: the 36-byte command and 20-byte slave packets (layout, scaling, CRC), for
+//!   DC motors (PWM duties, encoder counts) or position servos (goals, present positions);
+//! - [`drive`]: a joint's counts and setpoints in the controller's units;
 //! - [`config`]: the link configuration file (addresses, period, Fig. 2.21 timing, safety);
 //! - [`clock`]: precise waits on the monotonic clock for the deadline loop;
 //! - [`master`]: the deadline loop, packet freshness and the safety stops;
@@ -18,6 +20,7 @@
 
 pub mod clock;
 pub mod config;
+pub mod drive;
 pub mod emulator;
 pub mod faults;
 pub mod master;

@@ -4,6 +4,13 @@
 //! ours and is defined here only (docs/protocol.md describes it for firmware writers, the
 //! Python mirror `hexadyn.link.packets` encodes it byte for byte).
 //!
+//! Two kinds of packets share this layout, told apart by their protocol version
+//! ([`Protocol`]): version 1 carries PWM duties to DC motors and encoder counts back (AMRU5,
+//! serial legs under the master's PI); version 2 carries goal positions to position servos and
+//! their present positions back (a Dynamixel bus behind each leg's board, beyond the thesis).
+//! A command word's 12 low bits are a [`Setpoint`] of either kind ([`Duty`], [`Goal`]); the
+//! header, the sequence numbers and the CRCs are the same.
+//!
 //! Everything is little-endian. The wire structs are `zerocopy` types: a datagram of the right
 //! size is viewed in place, every field read through its byte-order type, and the sizes are
 //! checked at compile time.
@@ -23,6 +30,11 @@
 //! 500 counts per motor revolution, Section 2.3.2); bytes 12-17 the three motor currents
 //! (i16, mA); byte 18 the supply voltage (u8, 0.1 V); byte 19 the CRC-8/AUTOSAR of bytes 0-18.
 //!
+//! **Servo variant** (version 2): command word bits 0-10 a servo's goal position in its
+//! position register's counts (0..2047), bit 11 its torque enable; the slave packet's three
+//! 24-bit fields hold the servos' present positions in the same counts (0..2047) and its
+//! currents the servos' present currents.
+//!
 //! Parsers check, in this order, the size, the CRC, the version and the value ranges, and
 //! return a [`PacketError`]; they never panic on any input.
 
@@ -34,8 +46,8 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 
 use crate::hexapod::{JOINTS, LEG_COUNT};
 
-/// Protocol version carried by both packets.
-pub const PROTOCOL_VERSION: u8 = 1;
+/// Protocol version of AMRU5's packets (motor duties, encoder counts).
+pub const PROTOCOL_VERSION: u8 = Protocol::Motors.version();
 /// Size of the command packet (Section 2.3.2: "a 36 bytes buffer").
 pub const COMMAND_SIZE: usize = 36;
 /// Size of a slave packet (Section 2.3.2: "a 20 bytes buffer per slave").
@@ -52,10 +64,16 @@ pub const SUPPLY_LSB_V: f64 = 0.1;
 /// Range of a signed 24-bit encoder count.
 pub const COUNT_MIN: i32 = -(1 << 23);
 pub const COUNT_MAX: i32 = (1 << 23) - 1;
+/// Largest servo position (goal or present) in the servo variant: 11 bits.
+pub const GOAL_MAX: u16 = 0x07FF;
 
 const DUTY_MASK: u16 = 0x03FF;
 const DIRECTION_BIT: u16 = 1 << 10;
 const RESERVED_BIT: u16 = 1 << 11;
+/// A servo command word's torque enable (the servo variant's bit 11).
+const TORQUE_BIT: u16 = 1 << 11;
+/// The setpoint bits of a command word (below the header nibble).
+const SETPOINT_MASK: u16 = 0x0FFF;
 const NIBBLE_SHIFT: u16 = 12;
 /// Header bytes spread over the top nibbles of the 18 command words.
 const HEADER_BYTES: usize = JOINTS / 2;
@@ -67,6 +85,34 @@ const CRC_WORDS: [usize; 4] = [2 * HEADER_CRC, 2 * HEADER_CRC + 1, 2 * HEADER_CR
 
 const CRC8: Crc<u8> = Crc::<u8>::new(&CRC_8_AUTOSAR);
 const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
+
+/// What the packets carry, told apart by the protocol version (the command header's byte 2,
+/// the slave packet's high nibble of byte 0): a board of one kind rejects the other's packets
+/// as [`PacketError::Version`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Protocol {
+    /// Version 1: PWM duties to DC motors, encoder counts back (AMRU5's boards, Section 2.3.2).
+    Motors,
+    /// Version 2: goal positions to position servos, their present positions back.
+    Servos,
+}
+
+impl Protocol {
+    pub const fn version(self) -> u8 {
+        match self {
+            Protocol::Motors => 1,
+            Protocol::Servos => 2,
+        }
+    }
+
+    /// The range of the slave packet's three position fields, with its description for errors.
+    fn counts(self) -> (i32, i32, &'static str) {
+        match self {
+            Protocol::Motors => (COUNT_MIN, COUNT_MAX, "a signed 24-bit encoder count"),
+            Protocol::Servos => (0, GOAL_MAX as i32, "0..2047 (an 11-bit servo position)"),
+        }
+    }
+}
 
 // =============================================================================================
 // Wire layout
@@ -124,8 +170,8 @@ pub enum PacketError {
     Size { expected: usize, got: usize },
     /// The CRC does not match the content (corrupted bytes).
     Checksum { computed: u16, received: u16 },
-    /// A protocol version this master or slave does not speak.
-    Version(u8),
+    /// A protocol version this master or slave does not speak (`got`), not `expected`.
+    Version { got: u8, expected: u8 },
     /// A field outside its range.
     OutOfRange { field: &'static str, value: i64, allowed: &'static str },
 }
@@ -135,7 +181,7 @@ impl fmt::Display for PacketError {
         match self {
             PacketError::Size { expected, got } => write!(f, "{got} bytes, expected {expected}"),
             PacketError::Checksum { computed, received } => write!(f, "CRC {received:#06x} does not match the content ({computed:#06x}): corrupted"),
-            PacketError::Version(v) => write!(f, "protocol version {v}, this side speaks {PROTOCOL_VERSION}"),
+            PacketError::Version { got, expected } => write!(f, "protocol version {got}, this side speaks {expected}"),
             PacketError::OutOfRange { field, value, allowed } => write!(f, "{field} = {value} out of range; allowed: {allowed}"),
         }
     }
@@ -157,7 +203,7 @@ impl PacketErrorCounts {
         match e {
             PacketError::Size { .. } => self.size += 1,
             PacketError::Checksum { .. } => self.checksum += 1,
-            PacketError::Version(_) => self.version += 1,
+            PacketError::Version { .. } => self.version += 1,
             PacketError::OutOfRange { .. } => self.range += 1,
         }
     }
@@ -171,10 +217,72 @@ impl PacketErrorCounts {
 // Commands
 // =============================================================================================
 
+/// What a command word carries in its 12 low bits, one per joint: the kind of the packets.
+/// The default is the stop (0 V, or the servo's torque off): the zero command.
+pub trait Setpoint: Copy + Default + fmt::Debug + PartialEq + Eq + Send + 'static {
+    /// The packets that carry it.
+    const PROTOCOL: Protocol;
+    /// Its 12 bits (bits 0-11 of the command word).
+    fn bits(self) -> u16;
+    /// The setpoint in bits 0-11 of a command `word`, or why they are none.
+    fn from_word(word: u16) -> Result<Self, PacketError>;
+}
+
 /// A motor command: the signed 10-bit PWM duty, −1023..=1023 (sign: the direction input of the
 /// LMD18200, magnitude: its PWM input).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Duty(i16);
+
+impl Setpoint for Duty {
+    const PROTOCOL: Protocol = Protocol::Motors;
+
+    fn bits(self) -> u16 {
+        self.0.unsigned_abs() | if self.0 < 0 { DIRECTION_BIT } else { 0 }
+    }
+
+    fn from_word(w: u16) -> Result<Self, PacketError> {
+        if w & RESERVED_BIT != 0 {
+            return Err(PacketError::OutOfRange { field: "command word bit 11 (reserved)", value: i64::from(w), allowed: "bit 11 clear" });
+        }
+        // Ten bits cannot exceed 1023: every duty field is in range.
+        let magnitude = (w & DUTY_MASK) as i16;
+        Ok(Duty(if w & DIRECTION_BIT == 0 { magnitude } else { -magnitude }))
+    }
+}
+
+/// A servo command (the servo variant): bits 0-10 the goal position in counts of the servo's
+/// position register (0..2047; the Goal Position of a Dynamixel), bit 11 the torque enable
+/// (0: the servo's torque off, its goal ignored). The default, all bits 0, is the stop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Goal(u16);
+
+impl Goal {
+    /// Torque off.
+    pub const OFF: Goal = Goal(0);
+
+    /// Holding `register` (0..=2047) with the torque on.
+    pub fn position(register: u16) -> Option<Goal> {
+        (register <= GOAL_MAX).then_some(Goal(register | TORQUE_BIT))
+    }
+
+    /// The goal register with the torque on; `None` with the torque off.
+    pub fn register(self) -> Option<u16> {
+        (self.0 & TORQUE_BIT != 0).then_some(self.0 & GOAL_MAX)
+    }
+}
+
+impl Setpoint for Goal {
+    const PROTOCOL: Protocol = Protocol::Servos;
+
+    fn bits(self) -> u16 {
+        self.0
+    }
+
+    /// Any 12 bits are a goal: a goal with the torque off is ignored by the servo.
+    fn from_word(w: u16) -> Result<Self, PacketError> {
+        Ok(Goal(w & SETPOINT_MASK))
+    }
+}
 
 impl Duty {
     pub const ZERO: Duty = Duty(0);
@@ -204,12 +312,17 @@ impl Duty {
     }
 }
 
-/// The content of a command packet: the sequence number of the period and the 18 duties.
+/// The content of a command packet: the sequence number of the period and the 18 setpoints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MotorCommands {
+pub struct Commands<S> {
     pub seq: u16,
-    pub duties: [Duty; JOINTS],
+    pub setpoints: [S; JOINTS],
 }
+
+/// A command packet of version 1: 18 motor duties.
+pub type MotorCommands = Commands<Duty>;
+/// A command packet of version 2: 18 servo goals.
+pub type ServoCommands = Commands<Goal>;
 
 /// The CRC of a command packet: over its bytes with the CRC nibbles (words 6-9) cleared.
 fn command_crc(bytes: &[u8; COMMAND_SIZE]) -> u16 {
@@ -227,21 +340,19 @@ fn put_command_crc(bytes: &mut [u8; COMMAND_SIZE], crc: u16) {
     }
 }
 
-impl MotorCommands {
-    /// Every motor at 0 V.
+impl<S: Setpoint> Commands<S> {
+    /// The stop: every motor at 0 V, or every servo's torque off.
     pub fn zero(seq: u16) -> Self {
-        MotorCommands { seq, duties: [Duty::ZERO; JOINTS] }
+        Commands { seq, setpoints: [S::default(); JOINTS] }
     }
 
     pub fn encode(&self) -> [u8; COMMAND_SIZE] {
         let mut header = [0u8; HEADER_BYTES];
         header[HEADER_SEQ..HEADER_SEQ + 2].copy_from_slice(&self.seq.to_le_bytes());
-        header[HEADER_VERSION] = PROTOCOL_VERSION;
+        header[HEADER_VERSION] = S::PROTOCOL.version();
         let mut packet = CommandPacket { words: [U16::ZERO; JOINTS] };
-        for (k, (word, duty)) in packet.words.iter_mut().zip(self.duties).enumerate() {
-            let d = duty.0;
-            let direction = if d < 0 { DIRECTION_BIT } else { 0 };
-            *word = U16::new(d.unsigned_abs() | direction | u16::from(nibble(&header, k)) << NIBBLE_SHIFT);
+        for (k, (word, setpoint)) in packet.words.iter_mut().zip(self.setpoints).enumerate() {
+            *word = U16::new((setpoint.bits() & SETPOINT_MASK) | u16::from(nibble(&header, k)) << NIBBLE_SHIFT);
         }
         let mut bytes = [0u8; COMMAND_SIZE];
         bytes.copy_from_slice(packet.as_bytes());
@@ -263,21 +374,18 @@ impl MotorCommands {
         if computed != received {
             return Err(PacketError::Checksum { computed, received });
         }
-        if header[HEADER_VERSION] != PROTOCOL_VERSION {
-            return Err(PacketError::Version(header[HEADER_VERSION]));
+        let expected = S::PROTOCOL.version();
+        if header[HEADER_VERSION] != expected {
+            return Err(PacketError::Version { got: header[HEADER_VERSION], expected });
         }
         if let Some(&b) = header[HEADER_CRC + 2..].iter().find(|&&b| b != 0) {
             return Err(PacketError::OutOfRange { field: "command header bytes 5-8 (reserved)", value: i64::from(b), allowed: "0" });
         }
-        if let Some(w) = words.iter().find(|&&w| w & RESERVED_BIT != 0) {
-            return Err(PacketError::OutOfRange { field: "command word bit 11 (reserved)", value: i64::from(*w), allowed: "bit 11 clear" });
+        let mut setpoints = [S::default(); JOINTS];
+        for (s, &w) in setpoints.iter_mut().zip(&words) {
+            *s = S::from_word(w)?;
         }
-        // Ten bits cannot exceed 1023: every duty field is in range.
-        let duties = words.map(|w| {
-            let magnitude = (w & DUTY_MASK) as i16;
-            Duty(if w & DIRECTION_BIT == 0 { magnitude } else { -magnitude })
-        });
-        Ok(MotorCommands { seq: u16::from_le_bytes([header[HEADER_SEQ], header[HEADER_SEQ + 1]]), duties })
+        Ok(Commands { seq: u16::from_le_bytes([header[HEADER_SEQ], header[HEADER_SEQ + 1]]), setpoints })
     }
 }
 
@@ -291,14 +399,17 @@ fn nibble(header: &[u8; HEADER_BYTES], k: usize) -> u8 {
 // =============================================================================================
 
 /// The content of a slave packet: what the board of one leg measured when it applied the
-/// command of period `seq` (Section 2.3.2, Fig. 2.19), in its raw units.
+/// command of period `seq` (Section 2.3.2, Fig. 2.19), in its raw units. Its protocol is that
+/// of the commands it answers: encode and decode take it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SlaveReply {
     /// Leg 0..5 (the board).
     pub leg: u8,
     /// Sequence number of the command this packet answers.
     pub seq: u16,
-    /// Encoder counts of q_r, q_v, q_h (500 per motor revolution), [`COUNT_MIN`, `COUNT_MAX`].
+    /// The three joints' position counts: encoder counts of q_r, q_v, q_h (500 per motor
+    /// revolution), [`COUNT_MIN`, `COUNT_MAX`]; with servos their present position registers,
+    /// 0..=[`GOAL_MAX`].
     pub counts: [i32; 3],
     /// Motor currents (mA), |i| <= [`CURRENT_MAX_MA`].
     pub currents_ma: [i16; 3],
@@ -307,15 +418,16 @@ pub struct SlaveReply {
 }
 
 impl SlaveReply {
-    /// A packet from measurements in SI units, saturated as the board's counters and A/D
-    /// converters saturate: counts to 24 bits, currents to ±25 A, the supply to 0..25.5 V.
-    /// `leg` is taken modulo 6.
-    pub fn measured(leg: usize, seq: u16, counts: [i64; 3], currents_a: [f64; 3], supply_v: f64) -> Self {
+    /// A packet of `protocol` from measurements in SI units, saturated as the board's counters
+    /// and A/D converters saturate: counts to 24 bits (servo positions to 0..2047), currents to
+    /// ±25 A, the supply to 0..25.5 V. `leg` is taken modulo 6.
+    pub fn measured(protocol: Protocol, leg: usize, seq: u16, counts: [i64; 3], currents_a: [f64; 3], supply_v: f64) -> Self {
         let max = f64::from(CURRENT_MAX_MA);
+        let (low, high, _) = protocol.counts();
         SlaveReply {
             leg: (leg % LEG_COUNT) as u8,
             seq,
-            counts: counts.map(|c| c.clamp(i64::from(COUNT_MIN), i64::from(COUNT_MAX)) as i32),
+            counts: counts.map(|c| c.clamp(i64::from(low), i64::from(high)) as i32),
             // NaN saturates to 0 in the cast.
             currents_ma: currents_a.map(|i| (i / CURRENT_LSB_A).round().clamp(-max, max) as i16),
             supply: (supply_v / SUPPLY_LSB_V).round().clamp(0.0, 255.0) as u8,
@@ -332,13 +444,14 @@ impl SlaveReply {
         f64::from(self.supply) / 10.0
     }
 
-    /// The packet; fields outside their ranges are saturated to them (use [`Self::measured`]
-    /// or [`Self::decode`] to build a valid one).
-    pub fn encode(&self) -> [u8; REPLY_SIZE] {
+    /// The packet of `protocol`; fields outside their ranges are saturated to them (use
+    /// [`Self::measured`] or [`Self::decode`] to build a valid one).
+    pub fn encode(&self, protocol: Protocol) -> [u8; REPLY_SIZE] {
+        let (low, high, _) = protocol.counts();
         let mut p = ReplyPacket {
-            version_leg: PROTOCOL_VERSION << 4 | (self.leg % LEG_COUNT as u8),
+            version_leg: protocol.version() << 4 | (self.leg % LEG_COUNT as u8),
             seq: U16::new(self.seq),
-            counts: self.counts.map(|c| I24::new(c.clamp(COUNT_MIN, COUNT_MAX))),
+            counts: self.counts.map(|c| I24::new(c.clamp(low, high))),
             currents: self.currents_ma.map(|i| I16::new(i.clamp(-CURRENT_MAX_MA, CURRENT_MAX_MA))),
             supply: self.supply,
             crc: 0,
@@ -349,25 +462,31 @@ impl SlaveReply {
         bytes
     }
 
-    pub fn decode(bytes: &[u8]) -> Result<Self, PacketError> {
+    /// The packet of `protocol` in `bytes`, or why they are none.
+    pub fn decode(bytes: &[u8], protocol: Protocol) -> Result<Self, PacketError> {
         let p = ReplyPacket::ref_from_bytes(bytes).map_err(|_| PacketError::Size { expected: REPLY_SIZE, got: bytes.len() })?;
         let computed = CRC8.checksum(&p.as_bytes()[..REPLY_SIZE - 1]);
         if computed != p.crc {
             return Err(PacketError::Checksum { computed: computed.into(), received: p.crc.into() });
         }
-        let version = p.version_leg >> 4;
-        if version != PROTOCOL_VERSION {
-            return Err(PacketError::Version(version));
+        let (version, expected) = (p.version_leg >> 4, protocol.version());
+        if version != expected {
+            return Err(PacketError::Version { got: version, expected });
         }
         let leg = p.version_leg & 0x0F;
         if usize::from(leg) >= LEG_COUNT {
             return Err(PacketError::OutOfRange { field: "leg", value: i64::from(leg), allowed: "0..5" });
         }
+        let counts = p.counts.map(I24::get);
+        let (low, high, allowed) = protocol.counts();
+        if let Some(&c) = counts.iter().find(|&&c| !(low..=high).contains(&c)) {
+            return Err(PacketError::OutOfRange { field: "position count", value: i64::from(c), allowed });
+        }
         let currents_ma = p.currents.map(|i| i.get());
         if let Some(&i) = currents_ma.iter().find(|i| i.unsigned_abs() > CURRENT_MAX_MA as u16) {
             return Err(PacketError::OutOfRange { field: "motor current (mA)", value: i64::from(i), allowed: "-25000..25000 (the ±25 A of the current transducer)" });
         }
-        Ok(SlaveReply { leg, seq: p.seq.get(), counts: p.counts.map(I24::get), currents_ma, supply: p.supply })
+        Ok(SlaveReply { leg, seq: p.seq.get(), counts, currents_ma, supply: p.supply })
     }
 }
 
@@ -387,12 +506,21 @@ mod tests {
     }
 
     fn any_commands() -> impl Strategy<Value = MotorCommands> {
-        (any::<u16>(), proptest::array::uniform18(any_duty())).prop_map(|(seq, duties)| MotorCommands { seq, duties })
+        (any::<u16>(), proptest::array::uniform18(any_duty())).prop_map(|(seq, setpoints)| MotorCommands { seq, setpoints })
+    }
+
+    fn any_servo_commands() -> impl Strategy<Value = ServoCommands> {
+        (any::<u16>(), proptest::array::uniform18((0u16..=SETPOINT_MASK).prop_map(Goal))).prop_map(|(seq, setpoints)| ServoCommands { seq, setpoints })
+    }
+
+    fn any_reply_of(protocol: Protocol) -> impl Strategy<Value = SlaveReply> {
+        let (low, high, _) = protocol.counts();
+        (0u8..6, any::<u16>(), proptest::array::uniform3(low..=high), proptest::array::uniform3(-CURRENT_MAX_MA..=CURRENT_MAX_MA), any::<u8>())
+            .prop_map(|(leg, seq, counts, currents_ma, supply)| SlaveReply { leg, seq, counts, currents_ma, supply })
     }
 
     fn any_reply() -> impl Strategy<Value = SlaveReply> {
-        (0u8..6, any::<u16>(), proptest::array::uniform3(COUNT_MIN..=COUNT_MAX), proptest::array::uniform3(-CURRENT_MAX_MA..=CURRENT_MAX_MA), any::<u8>())
-            .prop_map(|(leg, seq, counts, currents_ma, supply)| SlaveReply { leg, seq, counts, currents_ma, supply })
+        any_reply_of(Protocol::Motors)
     }
 
     proptest! {
@@ -405,21 +533,41 @@ mod tests {
 
         #[test]
         fn replies_round_trip(r in any_reply()) {
-            prop_assert_eq!(SlaveReply::decode(&r.encode()), Ok(r));
+            prop_assert_eq!(SlaveReply::decode(&r.encode(Protocol::Motors), Protocol::Motors), Ok(r));
+        }
+
+        /// The servo variant round-trips, and a board of either kind rejects the other's
+        /// packets by their version.
+        #[test]
+        fn servo_packets_round_trip_and_are_not_motor_packets(c in any_servo_commands(), r in any_reply_of(Protocol::Servos)) {
+            let bytes = c.encode();
+            prop_assert_eq!(ServoCommands::decode(&bytes), Ok(c));
+            prop_assert_eq!(MotorCommands::decode(&bytes), Err(PacketError::Version { got: 2, expected: 1 }));
+            let reply = r.encode(Protocol::Servos);
+            prop_assert_eq!(SlaveReply::decode(&reply, Protocol::Servos), Ok(r));
+            prop_assert_eq!(SlaveReply::decode(&reply, Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
+            let motor = MotorCommands { seq: c.seq, setpoints: [Duty::ZERO; JOINTS] }.encode();
+            prop_assert_eq!(ServoCommands::decode(&motor), Err(PacketError::Version { got: 1, expected: 2 }));
         }
 
         /// Any one byte of a valid packet changed is caught by the CRC-8 (a burst of at most 8
         /// bits): a corrupted byte never decodes.
         #[test]
-        fn one_corrupted_byte_is_caught(c in any_commands(), r in any_reply(), at in 0usize..36, x in 1u8..=255) {
+        fn one_corrupted_byte_is_caught(c in any_commands(), g in any_servo_commands(), r in any_reply(), at in 0usize..36, x in 1u8..=255) {
             let mut b = c.encode();
             b[at] ^= x;
             let caught = matches!(MotorCommands::decode(&b), Err(PacketError::Checksum { .. }));
             prop_assert!(caught, "command byte {} ^ {}", at, x);
-            let mut b = r.encode();
-            b[at % REPLY_SIZE] ^= x;
-            let caught = matches!(SlaveReply::decode(&b), Err(PacketError::Checksum { .. }));
-            prop_assert!(caught, "reply byte {} ^ {}", at % REPLY_SIZE, x);
+            let mut b = g.encode();
+            b[at] ^= x;
+            let caught = matches!(ServoCommands::decode(&b), Err(PacketError::Checksum { .. }));
+            prop_assert!(caught, "servo command byte {} ^ {}", at, x);
+            for protocol in [Protocol::Motors, Protocol::Servos] {
+                let mut b = SlaveReply { counts: r.counts.map(|c| c & i32::from(GOAL_MAX)), ..r }.encode(protocol);
+                b[at % REPLY_SIZE] ^= x;
+                let caught = matches!(SlaveReply::decode(&b, protocol), Err(PacketError::Checksum { .. }));
+                prop_assert!(caught, "reply byte {} ^ {} ({:?})", at % REPLY_SIZE, x, protocol);
+            }
         }
 
         /// Whatever a decoder accepts encodes back to the same bytes.
@@ -428,15 +576,20 @@ mod tests {
             if let Ok(c) = MotorCommands::decode(&bytes) {
                 prop_assert_eq!(&c.encode()[..], &bytes[..]);
             }
-            if let Ok(r) = SlaveReply::decode(&bytes) {
-                prop_assert_eq!(&r.encode()[..], &bytes[..]);
+            if let Ok(c) = ServoCommands::decode(&bytes) {
+                prop_assert_eq!(&c.encode()[..], &bytes[..]);
+            }
+            for protocol in [Protocol::Motors, Protocol::Servos] {
+                if let Ok(r) = SlaveReply::decode(&bytes, protocol) {
+                    prop_assert_eq!(&r.encode(protocol)[..], &bytes[..]);
+                }
             }
         }
     }
 
     /// The fuzz target of the link: 10^6 arbitrary datagrams (any size 0..64, then packets with
-    /// their CRC fixed so that the version and range checks are reached too) through both
-    /// parsers, with no panic; every rejection is counted under one kind.
+    /// their CRC fixed so that the version and range checks are reached too) through the
+    /// parsers of both kinds, with no panic; every rejection is counted under one kind.
     #[test]
     fn a_million_arbitrary_datagrams_never_panic() {
         use rand::{Rng, SeedableRng};
@@ -463,7 +616,18 @@ mod tests {
                 put_command_crc(&mut b, crc);
                 bytes.copy_from_slice(&b);
             }
-            for result in [MotorCommands::decode(bytes).map(|_| ()), SlaveReply::decode(bytes).map(|_| ())] {
+            // Half of the version nibbles forged to one of the two kinds.
+            if len == REPLY_SIZE && n % 4 == 3 {
+                bytes[0] = (1 + (n / 4 % 2) as u8) << 4 | (bytes[0] & 0x0F);
+                bytes[REPLY_SIZE - 1] = CRC8.checksum(&bytes[..REPLY_SIZE - 1]);
+            }
+            let results = [
+                MotorCommands::decode(bytes).map(|_| ()),
+                ServoCommands::decode(bytes).map(|_| ()),
+                SlaveReply::decode(bytes, Protocol::Motors).map(|_| ()),
+                SlaveReply::decode(bytes, Protocol::Servos).map(|_| ()),
+            ];
+            for result in results {
                 inputs += 1;
                 match result {
                     Ok(()) => accepted += 1,
@@ -471,7 +635,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(inputs, 2_000_000);
+        assert_eq!(inputs, 4_000_000);
         assert_eq!(counts.total() + accepted, inputs);
         // Every check was exercised.
         assert!(counts.size > 0 && counts.checksum > 0 && counts.version > 0 && counts.range > 0 && accepted > 0, "{counts:?}, {accepted} accepted");
@@ -514,16 +678,29 @@ mod tests {
         let mut duties = [Duty::ZERO; JOINTS];
         duties[0] = Duty(5);
         duties[17] = Duty(-1023);
-        let b = MotorCommands { seq: 0x1234, duties }.encode();
+        let b = MotorCommands { seq: 0x1234, setpoints: duties }.encode();
         assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x4005); // nibble 0 = 4 (seq low nibble), duty 5
         assert_eq!(u16::from_le_bytes([b[2], b[3]]) >> 12, 0x3);
         assert_eq!(u16::from_le_bytes([b[4], b[5]]) >> 12, 0x2);
         assert_eq!(u16::from_le_bytes([b[6], b[7]]) >> 12, 0x1);
         assert_eq!(u16::from_le_bytes([b[8], b[9]]) >> 12, 0x1); // version 1, low nibble
         assert_eq!(u16::from_le_bytes([b[34], b[35]]), 0x07FF); // direction + 1023
-        let r = SlaveReply { leg: 3, seq: 0x1234, counts: [-1, 0x123456, 0], currents_ma: [-2, 0, 25_000], supply: 120 }.encode();
+        let r = SlaveReply { leg: 3, seq: 0x1234, counts: [-1, 0x123456, 0], currents_ma: [-2, 0, 25_000], supply: 120 }.encode(Protocol::Motors);
         assert_eq!(&r[..12], &[0x13, 0x34, 0x12, 0xFF, 0xFF, 0xFF, 0x56, 0x34, 0x12, 0, 0, 0]);
         assert_eq!(&r[12..19], &[0xFE, 0xFF, 0, 0, 0xA8, 0x61, 120]);
+        // The servo variant (docs/protocol.md): goal 512 with the torque on at servo 0, torque
+        // off at servo 17; leg 3's present positions 0, 512, 2047.
+        let mut goals = [Goal::OFF; JOINTS];
+        goals[0] = Goal::position(512).unwrap();
+        let b = ServoCommands { seq: 0x1234, setpoints: goals }.encode();
+        assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x4A00); // nibble 4, torque on, 512
+        assert_eq!(u16::from_le_bytes([b[8], b[9]]) >> 12, 0x2); // version 2
+        assert_eq!(u16::from_le_bytes([b[34], b[35]]) & 0x0FFF, 0);
+        assert_eq!(Goal::position(2048), None);
+        assert_eq!((goals[0].register(), Goal::OFF.register()), (Some(512), None));
+        let r = SlaveReply { leg: 3, seq: 0x1234, counts: [0, 512, 2047], currents_ma: [-2, 0, 1500], supply: 111 }.encode(Protocol::Servos);
+        assert_eq!(&r[..12], &[0x23, 0x34, 0x12, 0, 0, 0, 0, 0x02, 0, 0xFF, 0x07, 0]);
+        println!("servo command: {b:02x?}\nservo reply: {r:02x?}");
         // The catalogue check values of CRC-8/AUTOSAR and CRC-16/IBM-3740.
         assert_eq!(CRC8.checksum(b"123456789"), 0xDF);
         assert_eq!(CRC16.checksum(b"123456789"), 0x29B1);
@@ -537,21 +714,32 @@ mod tests {
         assert_eq!(Duty::from_voltage(f64::NAN, 12.0), Duty::ZERO);
         assert_eq!(Duty::from_voltage(1.0, 0.0), Duty::ZERO);
         assert!((Duty(512).voltage(12.0) - 6.005865102639296).abs() < 1e-12);
-        let r = SlaveReply::measured(7, 9, [1 << 30, -5, 0], [0.0015, f64::NAN, -99.0], 12.04);
+        let r = SlaveReply::measured(Protocol::Motors, 7, 9, [1 << 30, -5, 0], [0.0015, f64::NAN, -99.0], 12.04);
         assert_eq!((r.leg, r.counts, r.currents_ma, r.supply), (1, [COUNT_MAX, -5, 0], [2, 0, -25_000], 120));
+        let servo = SlaveReply::measured(Protocol::Servos, 0, 9, [1 << 30, -5, 300], [0.0; 3], 11.1);
+        assert_eq!(servo.counts, [2047, 0, 300]);
         assert_eq!(r.supply_voltage(), 12.0);
     }
 
     #[test]
     fn rejections_name_their_cause() {
-        assert_eq!(SlaveReply::decode(&[0; 19]), Err(PacketError::Size { expected: 20, got: 19 }));
-        let mut b = SlaveReply { leg: 0, seq: 1, counts: [0; 3], currents_ma: [0; 3], supply: 120 }.encode();
+        assert_eq!(SlaveReply::decode(&[0; 19], Protocol::Motors), Err(PacketError::Size { expected: 20, got: 19 }));
+        let mut b = SlaveReply { leg: 0, seq: 1, counts: [0; 3], currents_ma: [0; 3], supply: 120 }.encode(Protocol::Motors);
         b[0] = 0x26; // version 2, leg 6
         b[19] = CRC8.checksum(&b[..19]);
-        assert_eq!(SlaveReply::decode(&b), Err(PacketError::Version(2)));
+        assert_eq!(SlaveReply::decode(&b, Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
+        assert!(matches!(SlaveReply::decode(&b, Protocol::Servos), Err(PacketError::OutOfRange { field: "leg", value: 6, .. })));
         b[0] = 0x16;
         b[19] = CRC8.checksum(&b[..19]);
-        assert!(matches!(SlaveReply::decode(&b), Err(PacketError::OutOfRange { field: "leg", value: 6, .. })));
+        assert!(matches!(SlaveReply::decode(&b, Protocol::Motors), Err(PacketError::OutOfRange { field: "leg", value: 6, .. })));
+        // A servo position beyond 11 bits (a forged or wrong-kind packet).
+        b[0] = 0x20;
+        b[3] = 0xFF; // -1 in the first 24-bit field
+        b[4] = 0xFF;
+        b[5] = 0xFF;
+        b[19] = CRC8.checksum(&b[..19]);
+        assert!(matches!(SlaveReply::decode(&b, Protocol::Servos), Err(PacketError::OutOfRange { field: "position count", value: -1, .. })));
+        assert_eq!(PacketError::Version { got: 2, expected: 1 }.to_string(), "protocol version 2, this side speaks 1");
         assert_eq!(seq_distance(2, 65534), 4);
         assert_eq!(seq_distance(65534, 2), -4);
     }

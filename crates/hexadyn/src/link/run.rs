@@ -13,14 +13,18 @@
 //! | `q_r[i]`, `q_v[i]`, `q_h[i]` | rad, m, m | encoder positions |
 //! | `q_r_ref[i]` ... | rad, m | joint references computed at t (modes `pi` and `gait`) |
 //! | gait columns | | as in a simulation (`X_ref` ... `phase[l]` ... `foot_ref_z[l]`) |
-//! | `u_q_v[i]` ... | V | voltage held over the period ending at t: duty / 1023 × the board's supply |
+//! | `q_r_goal[i]` ... | rad, m | with servos: the goal sent at the next deadline (the nearest register) |
+//! | `u_q_v[i]` ... | V | voltage held over the period ending at t: duty / 1023 × the board's supply (NaN with servos) |
 //! | `i_q_v[i]` ... | A | motor current measured by the board |
 //! | `u_supply` | V | lowest supply voltage of the six boards |
-//! | `E_el_q_v[i]`, `E_joule_q_v[i]` | J | cumulative Σ u i Δt and Σ (R + R_bridge) i² Δt of the samples |
+//! | `E_el_q_v[i]`, `E_joule_q_v[i]` | J | cumulative Σ u i Δt (NaN with servos) and Σ (R + R_bridge) i² Δt of the samples |
 //! | `E_fric_q_v[i]` | J | not measured on the robot: NaN |
 //! | `lateness` | s | lateness of the broadcast of the period against its deadline |
 //! | `last_reply` | s | when the last slave packet of the period arrived after the broadcast |
 //! | `missed_periods` | 1 | periods missed so far (a slave packet missing at the deadline) |
+//!
+//! The joint columns are named after the robot's joints (`coxa[i]` ... on the PhantomX); with
+//! servos the voltage figures of the summary are NaN (the servos' own loops set the voltages).
 //!
 //! The run makes as many controller updates as the simulation of the scenario; each missed
 //! period (no update) adds a period, so the last row's t exceeds the duration by the missed
@@ -36,9 +40,13 @@ use std::time::{Duration, Instant};
 
 use super::clock::{realtime_thread, Percentiles};
 use super::config::LinkConfig;
+use super::drive::{Drive, JointScale};
 use super::master::{LinkEvent, LinkStats, SafetyStop};
+use super::protocol::{Duty, Goal, Protocol, COUNT_MAX, COUNT_MIN, GOAL_MAX};
 use super::{LinkError, UdpPlant};
 use crate::control::{Command, Measurements};
+use crate::description::serial::DriveControl;
+use crate::description::Robot;
 use crate::hexapod::{LegJoints, JOINTS};
 use crate::robot::recorder::{Recorder, TimeSeries};
 use crate::robot::simulation::run_until;
@@ -60,23 +68,49 @@ pub struct RobotRun {
     pub events: Vec<LinkEvent>,
 }
 
-/// The link carries AMRU5's slave boards: a pantograph robot's scenario only.
-pub(crate) fn check_robot(s: &Scenario) -> Result<(), LinkError> {
-    if s.robot.pantograph().is_none() {
-        return Err(LinkError::Mismatch(format!(
-            "{}: scenario.robot = {}: a {} robot; allowed: a pantograph robot (the link protocol of docs/protocol.md carries AMRU5's slave boards: motor voltages out, motor encoder counts in)",
-            s.origin,
-            s.robot_source,
-            s.robot.leg_mechanism()
-        )));
+/// The packets of the scenario's robot: motor duties for DC motors (AMRU5's boards, serial
+/// legs under the master's PI), servo goals for position servos. Refuses a robot whose counts
+/// the packets cannot carry: servo sensors of more than 2048 counts (11-bit positions), or
+/// joint ranges beyond the packets' counts.
+pub(crate) fn check_robot(s: &Scenario) -> Result<Protocol, LinkError> {
+    let Robot::Serial(r) = &s.robot else { return Ok(Protocol::Motors) };
+    let protocol = if r.has_servos() { Protocol::Servos } else { Protocol::Motors };
+    let file = s.robot.origin();
+    for (drive, name) in r.drives.iter().zip(r.joints.names()) {
+        if let DriveControl::Servo(servo) = &drive.control {
+            let counts = servo.sensor_counts;
+            if counts.fract() != 0.0 || counts > f64::from(GOAL_MAX) + 1.0 {
+                return Err(LinkError::Mismatch(format!("{file}: drives.{name}.servo.sensor_counts = {counts}: not a servo position the link carries; allowed: a whole number of counts up to 2048 (the 11-bit positions of docs/protocol.md, servo variant)")));
+            }
+        }
     }
-    Ok(())
+    let (low, high) = match protocol {
+        Protocol::Motors => (i64::from(COUNT_MIN), i64::from(COUNT_MAX)),
+        Protocol::Servos => (0, i64::from(GOAL_MAX)),
+    };
+    let encoders = s.robot.parts(&s.model).encoders;
+    for k in 0..JOINTS {
+        let scale = JointScale::new(protocol, encoders[k]);
+        let (lower, upper) = s.robot.joint_range(k);
+        for (end, q) in [("lower", lower), ("upper", upper)] {
+            let count = scale.count(q);
+            if !(low..=high).contains(&count) {
+                return Err(LinkError::Mismatch(format!(
+                    "{file}: legs[{}].joints[{}].{end} = {q}: count {count} of the joint's position sensor, beyond the link's packets; allowed: a joint range within counts {low}..{high} (docs/protocol.md)",
+                    k / 3,
+                    k % 3
+                )));
+            }
+        }
+    }
+    Ok(protocol)
 }
 
-/// Checks that the scenario can run on the link: a pantograph robot, the same control period,
-/// and no navigation system (the robot has none, Section 2.3.2: level A is not implemented).
-pub fn check(s: &Scenario, config: &LinkConfig) -> Result<(), LinkError> {
-    check_robot(s)?;
+/// Checks that the scenario can run on the link: a robot whose counts the packets carry, the
+/// same control period, and no navigation system (the robot has none, Section 2.3.2: level A
+/// is not implemented). Returns the packets of the robot.
+pub fn check(s: &Scenario, config: &LinkConfig) -> Result<Protocol, LinkError> {
+    let protocol = check_robot(s)?;
     let link = config.timing.period.as_secs_f64();
     if (link - s.period()).abs() > 1e-9 * s.period() {
         return Err(LinkError::Mismatch(format!(
@@ -90,7 +124,7 @@ pub fn check(s: &Scenario, config: &LinkConfig) -> Result<(), LinkError> {
     if s.gait.as_ref().is_some_and(|g| g.navigation) {
         return Err(LinkError::Mismatch(format!("{}: gait.navigation = true, but the robot has no navigation system; allowed: a scenario with navigation = false", s.origin)));
     }
-    Ok(())
+    Ok(protocol)
 }
 
 /// A run on its master thread.
@@ -123,14 +157,17 @@ impl RunHandle {
 
 /// Starts the run on a dedicated master thread.
 pub fn spawn_robot_run(s: Scenario, config: LinkConfig) -> Result<RunHandle, LinkError> {
-    check(&s, &config)?;
+    let protocol = check(&s, &config)?;
     let periods = Arc::new(AtomicU64::new(0));
     let interrupt = Arc::new(AtomicBool::new(false));
     let period = s.period();
     let (p, i) = (periods.clone(), interrupt.clone());
     let thread = std::thread::Builder::new()
         .name("hexadyn-master".into())
-        .spawn(move || master_thread(&s, &config, &p, i))
+        .spawn(move || match protocol {
+            Protocol::Motors => master_thread::<Duty>(&s, &config, &p, i),
+            Protocol::Servos => master_thread::<Goal>(&s, &config, &p, i),
+        })
         .map_err(|e| LinkError::Emulator(format!("cannot start the master thread: {e}")))?;
     Ok(RunHandle { thread, periods, interrupt, period })
 }
@@ -148,17 +185,19 @@ pub fn run_robot(s: &Scenario, config: &LinkConfig, mut progress: impl FnMut(f64
     handle.join()
 }
 
-fn master_thread(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interrupt: Arc<AtomicBool>) -> Result<RobotRun, LinkError> {
+fn master_thread<S: Drive>(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interrupt: Arc<AtomicBool>) -> Result<RobotRun, LinkError> {
     let started = Instant::now();
     let realtime = realtime_thread(config.timing.realtime_priority);
     // Everything is built before the link starts: the first deadline must not wait on it.
     let mut controller = ScenarioController::new(s);
     let gait = controller.gait_columns();
     let pi = s.control.tracks_references();
-    let d = s.robot.pantograph().expect("checked: a pantograph robot");
-    let resistance = d.circuit_resistance_ohm();
-    let mut row = Row { rec: Recorder::default(), joints: d.joints.names.clone(), gait, pi, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
-    let mut plant = UdpPlant::connect(config, d, interrupt)?;
+    let parts = s.robot.parts(&s.model);
+    let resistance = parts.motors.map(|m| m.r + m.r_bridge);
+    let servos = S::PROTOCOL == Protocol::Servos;
+    let mut row = Row { rec: Recorder::default(), joints: s.robot.joints().clone(), gait, pi, servos, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
+    let scales = parts.encoders.map(|e| JointScale::new(S::PROTOCOL, e));
+    let mut plant = UdpPlant::<S>::connect(config, scales, interrupt)?;
     // As many controller updates as in a simulation: the controllers count their updates (the
     // gait integrates its body reference by Δt per update), so a missed period, which runs no
     // update, lengthens the run by one period.
@@ -184,6 +223,7 @@ struct Sample<'a> {
     period: u64,
     positions: &'a [f64; JOINTS],
     references: &'a [f64; JOINTS],
+    goals: &'a [f64; JOINTS],
     voltages: &'a [f64; JOINTS],
     currents: &'a [f64; JOINTS],
     supply: f64,
@@ -199,7 +239,10 @@ struct Row {
     joints: LegJoints,
     gait: GaitColumns,
     pi: bool,
-    resistance: f64,
+    /// Position servos: the goal columns, no voltages.
+    servos: bool,
+    /// R + R_bridge of each joint's circuit (Ω).
+    resistance: [f64; JOINTS],
     last_t: Option<f64>,
     e_el: [f64; JOINTS],
     e_joule: [f64; JOINTS],
@@ -210,17 +253,17 @@ struct Row {
 }
 
 impl Row {
-    fn record(&mut self, p: &UdpPlant, m: &Measurements, cmd: &Command) {
+    fn record<S: Drive>(&mut self, p: &UdpPlant<S>, m: &Measurements, cmd: &Command) {
         let nan = [f64::NAN; JOINTS];
         for missed in p.missed() {
-            self.put(&Sample { t: missed.t, period: missed.period, positions: &nan, references: &nan, voltages: &missed.voltages, currents: &nan, supply: f64::NAN, lateness: missed.lateness, last_reply: f64::NAN, missed: p.stats().missed_periods });
+            self.put(&Sample { t: missed.t, period: missed.period, positions: &nan, references: &nan, goals: &nan, voltages: &missed.voltages, currents: &nan, supply: f64::NAN, lateness: missed.lateness, last_reply: f64::NAN, missed: p.stats().missed_periods });
         }
         let u = p.held_voltages();
         let dt = self.last_t.map_or(0.0, |t| m.t - t);
         self.last_t = Some(m.t);
         for k in 0..JOINTS {
             self.e_el[k] += u[k] * m.currents[k] * dt;
-            self.e_joule[k] += self.resistance * m.currents[k] * m.currents[k] * dt;
+            self.e_joule[k] += self.resistance[k] * m.currents[k] * m.currents[k] * dt;
             self.max_voltage = self.max_voltage.max(u[k].abs());
             self.commands += 1;
             if cmd.voltages[k].abs() >= m.supply_voltage {
@@ -230,7 +273,8 @@ impl Row {
                 self.tracking[k % 3] = self.tracking[k % 3].max((cmd.references[k] - m.positions[k]).abs());
             }
         }
-        self.put(&Sample { t: m.t, period: p.period_index(), positions: &m.positions, references: &cmd.references, voltages: &u, currents: &m.currents, supply: m.supply_voltage, lateness: p.lateness(), last_reply: p.last_reply(), missed: p.stats().missed_periods });
+        let goals = p.goals(cmd);
+        self.put(&Sample { t: m.t, period: p.period_index(), positions: &m.positions, references: &cmd.references, goals: &goals, voltages: &u, currents: &m.currents, supply: m.supply_voltage, lateness: p.lateness(), last_reply: p.last_reply(), missed: p.stats().missed_periods });
     }
 
     /// One row. A missed period gets a row too (NaN where nothing was measured, the energies
@@ -248,6 +292,11 @@ impl Row {
         if self.pi {
             for k in 0..JOINTS {
                 rec.put(x.references[k], || (self.joints.column("", k, "_ref"), self.joints.unit(k, ("rad", "m")), format!("PI reference computed at t, leg {} (NaN: period missed)", k / 3)));
+            }
+        }
+        if self.servos {
+            for k in 0..JOINTS {
+                rec.put(x.goals[k], || (self.joints.column("", k, "_goal"), self.joints.unit(k, ("rad", "m")), format!("servo goal sent at the next deadline, the nearest position register, leg {} (NaN: period missed)", k / 3)));
             }
         }
         self.gait.record(rec);
@@ -311,8 +360,8 @@ impl Row {
             ("robot_mass_kg", Number(s.robot.total_mass_kg())),
             ("energy_electrical_j", Number(energy)),
             ("average_power_w", Number(if duration > 0.0 { energy / duration } else { 0.0 })),
-            ("max_abs_voltage_v", Number(self.max_voltage)),
-            ("saturated_fraction", Number(if self.commands > 0 { self.saturated as f64 / self.commands as f64 } else { 0.0 })),
+            ("max_abs_voltage_v", Number(if self.servos { f64::NAN } else { self.max_voltage })),
+            ("saturated_fraction", Number(if self.servos { f64::NAN } else if self.commands > 0 { self.saturated as f64 / self.commands as f64 } else { 0.0 })),
         ];
         let mut v: Vec<_> = entries.into_iter().map(|(n, x)| (Cow::Borrowed(n), x)).collect();
         if self.pi {

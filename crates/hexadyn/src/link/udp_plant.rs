@@ -10,21 +10,23 @@
 //! the controller: the same command is broadcast again at the next deadline (the thesis: "the
 //! update cycle will be missed, but corrected during the next cycle").
 //!
-//! Conversions, per joint k = 3 leg + j: position = counts · 2π / (500 n) (the [`Encoder`] of
-//! the simulated robot); the voltage u becomes the duty round(u / U · 1023) with U the supply
-//! measured by that leg's board; the supply the controller sees is the lowest of the six.
+//! Conversions, per joint k = 3 leg + j ([`super::drive`]): position = counts · 2π / (500 n)
+//! (the robot's encoder of the joint; with servos, from the middle of the servo's sensor); the
+//! voltage u becomes the duty round(u / U · 1023) with U the supply measured by that leg's
+//! board, or, with servos, the goal (the reference without a friction feed-forward) the
+//! nearest register; the supply the controller sees is the lowest of the six.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
 use super::config::LinkConfig;
+use super::drive::{Drive, JointScale};
 use super::master::{LinkEvent, LinkStats, Master, StopReason};
-use super::protocol::{Duty, SlaveReply};
+use super::protocol::SlaveReply;
 use super::LinkError;
-use crate::control::{Command, Encoder, Measurements, Plant};
-use crate::description::RobotDescription;
-use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
+use crate::control::{Command, Measurements, Plant};
+use crate::hexapod::{JOINTS, LEG_COUNT};
 
 /// A period whose slave packets did not all arrive: no measurements, the controller did not run.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,18 +39,18 @@ pub struct MissedPeriod {
     pub lateness: f64,
 }
 
-/// The robot behind the master/slave link.
-pub struct UdpPlant {
-    master: Master,
-    encoders: [Encoder; JOINTS],
+/// The robot behind the master/slave link, its boards driven by setpoints `S`.
+pub struct UdpPlant<S: Drive> {
+    master: Master<S>,
+    scales: [JointScale; JOINTS],
     dt: f64,
     replies: [SlaveReply; LEG_COUNT],
     measurements: Measurements,
     /// The controller's command, to broadcast at the next deadline.
-    next: [Duty; JOINTS],
+    next: [S; JOINTS],
     /// The last broadcast, and the one before: held over the period ending at the measurements.
-    broadcast: [Duty; JOINTS],
-    held: [Duty; JOINTS],
+    broadcast: [S; JOINTS],
+    held: [S; JOINTS],
     ready_at: Instant,
     /// The period of the first measurements: t = 0 there.
     origin: u64,
@@ -60,23 +62,23 @@ pub struct UdpPlant {
     interrupt: Arc<AtomicBool>,
 }
 
-impl UdpPlant {
-    /// Opens the link and waits for the six slaves (0 V broadcast until they all answer).
-    /// `interrupt` stops the robot at the next period when set.
-    pub fn connect(config: &LinkConfig, robot: &RobotDescription, interrupt: Arc<AtomicBool>) -> Result<Self, LinkError> {
+impl<S: Drive> UdpPlant<S> {
+    /// Opens the link and waits for the six slaves (the zero command broadcast until they all
+    /// answer); `scales`: the joints' position counts. `interrupt` stops the robot at the next
+    /// period when set.
+    pub fn connect(config: &LinkConfig, scales: [JointScale; JOINTS], interrupt: Arc<AtomicBool>) -> Result<Self, LinkError> {
         let mut master = Master::bind(config)?;
         master.start_clock();
         let replies = master.connect()?;
-        let encoders = std::array::from_fn(|k| Encoder { counts_per_rev: robot.controller.encoder_impulses_per_rev, n: robot.reduction(PantographJoint::ALL[k % 3]) });
         let mut plant = UdpPlant {
             master,
-            encoders,
+            scales,
             dt: config.timing.period.as_secs_f64(),
             replies,
             measurements: Measurements::default(),
-            next: [Duty::ZERO; JOINTS],
-            broadcast: [Duty::ZERO; JOINTS],
-            held: [Duty::ZERO; JOINTS],
+            next: [S::default(); JOINTS],
+            broadcast: [S::default(); JOINTS],
+            held: [S::default(); JOINTS],
             ready_at: Instant::now(),
             origin: 0,
             missed: Vec::new(),
@@ -94,7 +96,7 @@ impl UdpPlant {
         m.t = (self.master.period() - self.origin) as f64 * self.dt;
         for k in 0..JOINTS {
             let r = &replies[k / 3];
-            m.positions[k] = f64::from(r.counts[k % 3]) * self.encoders[k].resolution();
+            m.positions[k] = self.scales[k].position(r.counts[k % 3]);
             m.currents[k] = r.currents()[k % 3];
         }
         m.supply_voltage = replies.iter().map(SlaveReply::supply_voltage).fold(f64::INFINITY, f64::min);
@@ -118,9 +120,15 @@ impl UdpPlant {
     }
 
     /// The voltages held over the period that ended at the current measurements: the duties
-    /// broadcast then, times the supply each board measured.
+    /// broadcast then, times the supply each board measured (NaN with servos).
     pub fn held_voltages(&self) -> [f64; JOINTS] {
-        std::array::from_fn(|k| self.held[k].voltage(self.replies[k / 3].supply_voltage()))
+        std::array::from_fn(|k| self.held[k].held_voltage(self.replies[k / 3].supply_voltage()))
+    }
+
+    /// The servo goals `command` becomes, to be broadcast at the next deadline (rad or m, whole
+    /// registers; NaN with motors).
+    pub fn goals(&self, command: &Command) -> [f64; JOINTS] {
+        std::array::from_fn(|k| S::commanded(command, k, &self.scales[k], self.replies[k / 3].supply_voltage()).goal(&self.scales[k]))
     }
 
     pub fn stats(&self) -> &LinkStats {
@@ -141,7 +149,7 @@ impl UdpPlant {
         self.master.stats.lateness.last().copied().unwrap_or(0.0)
     }
 
-    /// Puts every motor to 0 V (the end of a run), counts what arrives during one more period,
+    /// Puts every motor to 0 V, every servo's torque off (the end of a run), counts what arrives during one more period,
     /// and returns what the master counted.
     pub fn finish(mut self) -> (LinkStats, Vec<LinkEvent>, Vec<f64>) {
         self.master.stop();
@@ -150,7 +158,7 @@ impl UdpPlant {
     }
 }
 
-impl Plant for UdpPlant {
+impl<S: Drive> Plant for UdpPlant<S> {
     type Error = LinkError;
 
     fn period(&self) -> f64 {
@@ -162,7 +170,7 @@ impl Plant for UdpPlant {
     }
 
     fn actuate(&mut self, command: &Command) {
-        self.next = std::array::from_fn(|k| Duty::from_voltage(command.voltages[k], self.replies[k / 3].supply_voltage()));
+        self.next = std::array::from_fn(|k| S::commanded(command, k, &self.scales[k], self.replies[k / 3].supply_voltage()));
     }
 
     fn wait_period(&mut self) -> Result<(), LinkError> {
@@ -171,12 +179,12 @@ impl Plant for UdpPlant {
             return Err(self.master.safety_stop(StopReason::Interrupted));
         }
         self.master.check_overrun()?;
-        let duties = self.next;
+        let setpoints = self.next;
         self.missed.clear();
         loop {
-            let outcome = self.master.run_period(&duties);
+            let outcome = self.master.run_period(&setpoints);
             self.held = self.broadcast;
-            self.broadcast = duties;
+            self.broadcast = setpoints;
             if let Some(replies) = outcome? {
                 self.accept(replies);
                 return Ok(());
