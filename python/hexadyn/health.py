@@ -56,10 +56,17 @@ MAX_DISTANCE_FRACTION = 0.5
 TRACKING_ALLOWANCE_M = 0.05
 
 
+# The specific resistance of a run that walks no distance, and the shares of the electrical
+# energy of a run that draws none (unpowered), are 0/0: not applicable, not a failure. Their
+# numerators and denominators are figures of their own and are checked as such.
+#: Ratios whose NaN means "not applicable".
+RATIOS = ("specific_resistance", "friction_share", "joule_share")
+
+
 def check(summary: Mapping[str, Any]) -> list[str]:
     """The failed health checks of a run's summary, one line each (empty: healthy)."""
     warnings = []
-    bad = [k for k, v in summary.items() if isinstance(v, float) and not math.isfinite(v) and k != "specific_resistance"]
+    bad = [k for k, v in summary.items() if isinstance(v, float) and not math.isfinite(v) and k not in RATIOS]
     if bad:
         warnings.append(f"non-finite figures: {', '.join(bad)}")
     balance = summary.get("energy_balance_error_relative")

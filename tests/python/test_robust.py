@@ -230,6 +230,9 @@ def test_health_checks_flag_meaningless_runs():
     ]:
         warnings = health.check({**healthy, **change})
         assert len(warnings) == 1 and words in warnings[0], (change, warnings)
+    # Without electrical energy (unpowered) the shares of it are 0/0: not applicable.
+    unpowered = {**healthy, "energy_electrical_j": 0.0, "friction_share": float("nan"), "joule_share": float("nan"), "specific_resistance": float("nan")}
+    assert health.check(unpowered) == []
 
 
 def test_strict_turns_warnings_into_an_exit_status(tmp_path: Path, monkeypatch):
