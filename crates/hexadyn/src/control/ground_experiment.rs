@@ -28,7 +28,7 @@ use nalgebra::Vector3;
 
 use super::ground_detection::{GroundDetector, GroundSensingLeg, LegDetection};
 use super::interface::{Command, Controller, Measurements};
-use super::gait::free::settling_time;
+use super::low_pass::settling_time;
 use super::{joint_command, DigitalPi, FrictionFeedForward};
 use crate::hexapod::{Leg, LegChain, LegKinematics, SerialLegKinematics, JOINTS, LEG_COUNT};
 

@@ -13,7 +13,7 @@
 use nalgebra::{Vector2, Vector3};
 
 use super::elevator::{resistance, retreat};
-use super::landing::settling_time;
+use crate::control::settling_time;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
 use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};

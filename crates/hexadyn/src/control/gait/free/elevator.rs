@@ -31,7 +31,7 @@
 use nalgebra::Vector3;
 
 #[cfg(doc)]
-use super::landing::SETTLING_TIME_CONSTANTS;
+use crate::control::SETTLING_TIME_CONSTANTS;
 
 /// How far the foot backs off from the obstacle before it rises (m): the foot radius of AMRU5
 /// (2 cm), so that the foot does not rub up the riser face under the PI's push.

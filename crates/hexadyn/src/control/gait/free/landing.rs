@@ -5,11 +5,11 @@
 //! ([`NormalForce`]). Any [`LandingDetector`] plugs into the free gait controller
 //! ([`super::FreeGaitController::new`]).
 
-use std::f64::consts::TAU;
-
 use nalgebra::Vector3;
 
-use crate::control::{GroundDetector, GroundSensingLeg, LegDetection, Measurements, DIGITAL_CUTOFF_HZ};
+use crate::control::{settling_time, GroundDetector, GroundSensingLeg, LegDetection, Measurements};
+#[cfg(doc)]
+use crate::control::SETTLING_TIME_CONSTANTS;
 use crate::description::Robot;
 
 /// Decides, at each control instant, which feet are on the ground, from the measurements. The
@@ -94,16 +94,6 @@ pub struct MotorCurrent<L> {
 /// tripod carries about 100 N, "high enough to catch the difference": the lowest threshold it
 /// validated, 40 N, is taken, the one closest to the 10 N of the simulation mode.
 pub const THESIS_CURRENT_THRESHOLD: f64 = 40.0;
-
-/// Time constants 1/(2π f_c) of the 3 Hz filters the vertical joint must have slid down before
-/// a detection: 3, after which a first-order filter has followed 95 % of a step (159 ms, 7 mm of
-/// the foot at the 4.5 cm/s of the landing).
-pub const SETTLING_TIME_CONSTANTS: f64 = 3.0;
-
-/// [`SETTLING_TIME_CONSTANTS`] time constants of the 3 Hz filters (s).
-pub fn settling_time() -> f64 {
-    SETTLING_TIME_CONSTANTS / (TAU * DIGITAL_CUTOFF_HZ)
-}
 
 impl<L: GroundSensingLeg> MotorCurrent<L> {
     /// The detector of `robot` with the kinematics `legs` of its legs at the control period

@@ -12,7 +12,7 @@ pub mod rules;
 pub mod velocity;
 
 pub use controller::{FreeGaitController, FreeGaitOptions, FreeGaitState};
-pub use landing::{settling_time, LandingDetector, MotorCurrent, NormalForce, THESIS_CURRENT_THRESHOLD, THESIS_FORCE_THRESHOLD};
+pub use landing::{LandingDetector, MotorCurrent, NormalForce, THESIS_CURRENT_THRESHOLD, THESIS_FORCE_THRESHOLD};
 
 #[cfg(test)]
 mod tests;
