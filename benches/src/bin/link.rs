@@ -10,7 +10,7 @@ use std::ops::ControlFlow;
 use std::path::Path;
 use std::time::Duration;
 
-use hexadyn::link::clock::Percentiles;
+use hexadyn::link::clock::{Clock, Percentiles};
 use hexadyn::link::emulator::{Emulator, EmulatorOptions};
 use hexadyn::link::run::run_robot;
 use hexadyn::link::LinkConfig;
@@ -26,7 +26,7 @@ fn main() {
     let emulator = Emulator::start(&s, &config, EmulatorOptions { idle_timeout: Some(Duration::from_secs(5)), ..Default::default() }).expect("emulator");
     config.broadcast.set_port(emulator.command_address().port());
     println!("hexadyn link benchmark: {periods} periods at 100 Hz, master + 6 emulated slaves on loopback ({} s)", duration);
-    let run = run_robot(&s, &config, |_| ControlFlow::Continue(())).expect("linked run");
+    let run = run_robot(&s, &config, Clock::Monotonic, |_| ControlFlow::Continue(())).expect("linked run");
     let report = emulator.stop();
     let st = &run.stats;
     let us = |p: Percentiles| format!("p50 {:8.1} us   p99 {:8.1} us   max {:8.1} us", p.p50 * 1e6, p.p99 * 1e6, p.max * 1e6);

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
+use hexadyn::link::clock::Clock;
 use hexadyn::link::emulator::{Emulator, EmulatorOptions};
 use hexadyn::link::faults::Faults;
 use hexadyn::link::protocol::{Commands, Duty, Goal, MotorCommands, Protocol, ServoCommands, Setpoint, SlaveReply, COMMAND_SIZE};
@@ -97,7 +98,7 @@ pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progres
     let s = load(&scenario, overrides.as_ref())?;
     let config = config(&link)?;
     let (text, robot, robot_source, duration) = (s.text.clone(), s.robot_text.clone(), s.robot_source.clone(), s.duration);
-    let handle = spawn_robot_run(s, config).map_err(value_error)?;
+    let handle = spawn_robot_run(s, config, Clock::Monotonic).map_err(value_error)?;
     let mut python_error = None;
     while !handle.is_finished() {
         py.detach(|| std::thread::sleep(POLL));
@@ -156,7 +157,7 @@ pub fn robot_emulate<'py>(
     let config = config(&link)?;
     let faults = faults_from(faults.as_ref())?;
     let idle_timeout = idle_timeout_s.map(|t| if t.is_finite() && t > 0.0 { Ok(Duration::from_secs_f64(t)) } else { Err(value_error(format!("idle timeout {t} s: allowed a time > 0"))) }).transpose()?;
-    let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { faults, idle_timeout, history: false })).map_err(value_error)?;
+    let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { faults, idle_timeout, ..Default::default() })).map_err(value_error)?;
     if let Some(f) = ready {
         f.call0(py)?;
     }
