@@ -4,7 +4,9 @@
 //! absolute monotonic clock; for each period, when the last slave packet arrived and how long
 //! the controller took. Target: p99 lateness under 100 µs and no missed period on an idle
 //! machine. `link N` runs N periods. The link threads ask for SCHED_FIFO priority 40 and run
-//! on the normal scheduler when that is not permitted (the output says which).
+//! on the normal scheduler when that is not permitted (the output says which). This is the one
+//! real-time measurement of the link, on the monotonic clock: its figures are quoted, never
+//! asserted (the tests run the link in lock-step on a virtual clock, `tests/link.rs`).
 
 use std::ops::ControlFlow;
 use std::path::Path;
