@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use hexadyn::link::emulator::{Emulator, EmulatorOptions};
+use hexadyn::link::clock::Clock;
+use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
 use hexadyn::link::faults::Faults;
 use hexadyn::link::protocol::{Commands, Duty, Goal, MotorCommands, Protocol, ServoCommands, Setpoint, SlaveReply, COMMAND_SIZE};
 use hexadyn::link::run::spawn_robot_run;
@@ -84,20 +85,33 @@ pub fn decode_reply(data: &[u8], version: u8) -> PyResult<(u8, u16, [i32; 3], [i
     Ok((r.leg, r.seq, r.counts, r.currents_ma, r.supply))
 }
 
-/// Runs the scenario's controller on the robot through the link configured in `link` and
-/// returns the dict of `run_scenario` ("columns", "units", "descriptions", "summary",
+/// Runs the scenario's controller on the robot through the link configured in `link` (with
+/// `emulated`, on the six emulated slaves instead, in this process, in lock-step on a virtual
+/// clock: free ports of the configured addresses, no real time, the same outcome on any
+/// machine) and returns the dict of `run_scenario` ("columns", "units", "descriptions", "summary",
 /// "scenario", "robot", "robot_source") plus "events" (the dropped packets and missed periods
-/// the master logged, as (period, message)) and "stop" (the safety stop, or None). Ctrl-C
+/// the master logged, as (period, message)), "stop" (the safety stop, or None) and, with
+/// `emulated`, "emulator" (the emulator's report, as `robot_emulate` returns it). Ctrl-C
 /// stops the robot at the next period (0 V) and returns what was recorded. `progress(t_s,
 /// duration_s)` is called every 100 ms. Raises ValueError for invalid files, a scenario that
 /// does not fit the link, or slaves that do not answer.
 #[pyfunction]
-#[pyo3(signature = (scenario, link, progress = None, overrides = None))]
-pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progress: Option<Py<PyAny>>, overrides: Option<Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scenario, link, progress = None, overrides = None, emulated = false))]
+pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progress: Option<Py<PyAny>>, overrides: Option<Bound<'py, PyDict>>, emulated: bool) -> PyResult<Bound<'py, PyDict>> {
     let s = load(&scenario, overrides.as_ref())?;
-    let config = config(&link)?;
+    let mut config = config(&link)?;
     let (text, robot, robot_source, duration) = (s.text.clone(), s.robot_text.clone(), s.robot_source.clone(), s.duration);
-    let handle = spawn_robot_run(s, config).map_err(value_error)?;
+    let (clock, emulator) = if emulated {
+        let clock = Clock::virtual_time();
+        config.master.set_port(0);
+        config.broadcast.set_port(0);
+        let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { clock: clock.clone(), ..Default::default() })).map_err(value_error)?;
+        config.broadcast.set_port(emulator.command_address().port());
+        (clock, Some(emulator))
+    } else {
+        (Clock::Monotonic, None)
+    };
+    let handle = spawn_robot_run(s, config, clock).map_err(value_error)?;
     let mut python_error = None;
     while !handle.is_finished() {
         py.detach(|| std::thread::sleep(POLL));
@@ -113,6 +127,7 @@ pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progres
         }
     }
     let run = py.detach(|| handle.join()).map_err(value_error)?;
+    let emulator = emulator.map(|e| py.detach(|| e.stop()));
     if let Some(e) = python_error {
         return Err(e);
     }
@@ -132,6 +147,9 @@ pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progres
     d.set_item("robot_source", robot_source)?;
     d.set_item("events", run.events.into_iter().map(|e| (e.period, e.message)).collect::<Vec<_>>())?;
     d.set_item("stop", run.stop.map(|s| s.to_string()))?;
+    if let Some(report) = emulator {
+        d.set_item("emulator", report_dict(py, &report, false)?)?;
+    }
     Ok(d)
 }
 
@@ -156,7 +174,7 @@ pub fn robot_emulate<'py>(
     let config = config(&link)?;
     let faults = faults_from(faults.as_ref())?;
     let idle_timeout = idle_timeout_s.map(|t| if t.is_finite() && t > 0.0 { Ok(Duration::from_secs_f64(t)) } else { Err(value_error(format!("idle timeout {t} s: allowed a time > 0"))) }).transpose()?;
-    let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { faults, idle_timeout, history: false })).map_err(value_error)?;
+    let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { faults, idle_timeout, ..Default::default() })).map_err(value_error)?;
     if let Some(f) = ready {
         f.call0(py)?;
     }
@@ -169,6 +187,11 @@ pub fn robot_emulate<'py>(
         }
     }
     let report = py.detach(|| emulator.wait(&AtomicBool::new(true)));
+    report_dict(py, &report, interrupted.is_some())
+}
+
+/// An emulator's report as a dict.
+fn report_dict<'py>(py: Python<'py>, report: &EmulatorReport, interrupted: bool) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("commands", report.commands)?;
     d.set_item("sent", report.sent)?;
@@ -185,8 +208,8 @@ pub fn robot_emulate<'py>(
     d.set_item("step_time_p99_s", report.step_time.p99)?;
     d.set_item("step_time_max_s", report.step_time.max)?;
     d.set_item("realtime", report.realtime)?;
-    d.set_item("error", report.error)?;
-    d.set_item("interrupted", interrupted.is_some())?;
+    d.set_item("error", report.error.clone())?;
+    d.set_item("interrupted", interrupted)?;
     Ok(d)
 }
 

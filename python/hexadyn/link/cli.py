@@ -26,7 +26,8 @@ def robot() -> None:
 @click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 @click.option("--no-plots", is_flag=True, help="Do not write the figures into <out>/plots/.")
-def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool) -> None:
+@click.option("--emulated", is_flag=True, help="Drive the six emulated slaves in this process instead of the robot, in lock-step on a virtual clock (free ports of the configured addresses, no real time: the same results on any machine).")
+def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, emulated: bool) -> None:
     """Drive the robot with SCENARIO's controller through the link and save what the master saw.
 
     The master broadcasts the 18 motor commands every period, collects the six slave packets and
@@ -34,7 +35,8 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
     one of `hexadyn simulate`: encoder positions, references, voltages, currents, energies of
     the samples, and the link's timing (lateness, last_reply, missed_periods). A safety stop (a
     slave silent for 3 periods, a controller overrun) or Ctrl-C puts every motor at 0 V; the
-    results up to it are saved, and the exit status is 1 for a safety stop.
+    results up to it are saved, and the exit status is 1 for a safety stop. With --emulated the
+    master drives `robot emulate`'s six slaves in lock-step instead (a rehearsal without timing).
     """
     from hexadyn import _core, energy, report
     from hexadyn.runner import free_results_folder
@@ -48,12 +50,12 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
     if no_progress:
-        raw = _core.robot_run(str(path), str(link_path))
+        raw = _core.robot_run(str(path), str(link_path), emulated=emulated)
     else:
         from tqdm.auto import tqdm
 
         with tqdm(total=info["duration_s"], desc=f"{info['name']} (robot)", unit="s", bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]") as bar:
-            raw = _core.robot_run(str(path), str(link_path), lambda t, _d: bar.update(max(0.0, t - bar.n)))
+            raw = _core.robot_run(str(path), str(link_path), lambda t, _d: bar.update(max(0.0, t - bar.n)), emulated=emulated)
     results = Results.from_engine(raw, scenario_path=path)
     energy.add_energy_figures(results)
     report.save(results, out, overwrite=overwrite)

@@ -1,4 +1,6 @@
-//! Precise waits on the monotonic clock for the deadline loop of Section 2.3.2.
+//! The clock of the deadline loop of Section 2.3.2: [`Clock`], the monotonic clock of the robot
+//! or a [`VirtualClock`] for a master and an emulator run in lock-step; precise waits on the
+//! monotonic clock.
 //!
 //! Socket read timeouts (SO_RCVTIMEO) run on the scheduler tick and come back milliseconds
 //! late. Like the thesis' master, which blocks in `select()` on the slaves' socket with a
@@ -10,7 +12,68 @@
 
 use std::io;
 use std::os::fd::RawFd;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+pub use super::virtual_clock::VirtualClock;
+
+/// The time of the master and of the emulated slaves.
+#[derive(Clone, Debug, Default)]
+pub enum Clock {
+    /// The monotonic clock, waited on precisely ([`wait_readable`]): the robot, `hexadyn robot
+    /// run` and `emulate`, the `link` benchmark.
+    #[default]
+    Monotonic,
+    /// Virtual time shared by a master and an emulator in one process (the tests).
+    Virtual(Arc<VirtualClock>),
+}
+
+impl Clock {
+    /// A new virtual clock.
+    pub fn virtual_time() -> Self {
+        Clock::Virtual(VirtualClock::new())
+    }
+
+    pub fn now(&self) -> Instant {
+        match self {
+            Clock::Monotonic => Instant::now(),
+            Clock::Virtual(v) => v.now(),
+        }
+    }
+
+    /// The master's wait: until `fd` is readable or `deadline` is reached (`spin`: the last part
+    /// of a wait on the monotonic clock spent spinning).
+    pub fn wait_readable(&self, fd: RawFd, deadline: Instant, spin: Duration) -> io::Result<Wake> {
+        match self {
+            Clock::Monotonic => wait_readable(fd, deadline, spin),
+            Clock::Virtual(v) => v.wait_readable(fd, deadline),
+        }
+    }
+
+    /// The master sent a command datagram.
+    pub(crate) fn command_sent(&self) {
+        if let Clock::Virtual(v) = self {
+            v.command_sent();
+        }
+    }
+
+    /// The master read a datagram.
+    pub(crate) fn datagram_received(&self) {
+        if let Clock::Virtual(v) = self {
+            v.datagram_received();
+        }
+    }
+}
+
+impl PartialEq for Clock {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Clock::Monotonic, Clock::Monotonic) => true,
+            (Clock::Virtual(a), Clock::Virtual(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
+}
 
 /// What ended a [`wait_readable`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

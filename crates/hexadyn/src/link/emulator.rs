@@ -15,14 +15,14 @@
 //! applied (a duplicate) or up to 255 periods before it (reordered) is ignored too. Faults
 //! ([`super::faults`]) are applied to the outgoing packets.
 //!
-//! Two threads: the model thread receives the commands, latches, schedules the packets and
-//! steps the model; the sender thread sends each packet at its time. With a real-time
-//! priority in the configuration, the sender runs at it and the model thread one below. The
-//! emulator stops on [`Emulator::stop`], or by itself after `idle_timeout` without a command
-//! once the first one came.
+//! On the monotonic clock, two threads: the model thread receives the commands, latches,
+//! schedules the packets and steps the model; the sender thread sends each packet at its time.
+//! With a real-time priority in the configuration, the sender runs at it and the model thread
+//! one below. On a virtual clock ([`EmulatorOptions::clock`]) the model thread is the same and
+//! the packets go to the clock's agenda, sent as the master's virtual time passes their due
+//! time ([`super::virtual_clock`]). The emulator stops on [`Emulator::stop`], or by itself
+//! after `idle_timeout` (wall time) without a command once the first one came.
 
-use std::collections::BinaryHeap;
-use std::cmp::Reverse;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
@@ -30,11 +30,13 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::clock::{realtime_thread, sleep_until, Percentiles};
+use super::agenda::{Agenda, Datagram};
+use super::clock::{realtime_thread, sleep_until, Clock, Percentiles};
 use super::config::LinkConfig;
 use super::drive::{Drive, JointScale};
 use super::faults::{FaultCounts, FaultInjector, Faults, Outgoing};
 use super::protocol::{seq_distance, Commands, Duty, Goal, PacketErrorCounts, Protocol, Setpoint, SlaveReply};
+use super::virtual_clock::VirtualClock;
 use super::LinkError;
 use crate::control::{Command, Plant};
 use crate::hexapod::{JOINTS, LEG_COUNT};
@@ -54,6 +56,9 @@ pub struct EmulatorOptions {
     pub idle_timeout: Option<Duration>,
     /// Keep the per-period history (tests and comparisons).
     pub history: bool,
+    /// The slaves' time: [`Clock::Monotonic`] answers in real time (`hexadyn robot emulate`); a
+    /// [`Clock::Virtual`] in lock-step with a master on the same clock.
+    pub clock: Clock,
 }
 
 /// One applied command and what the boards latched when applying it.
@@ -102,6 +107,7 @@ pub struct Emulator {
     stop: Arc<AtomicBool>,
     model: Option<JoinHandle<EmulatorReport>>,
     sender: Option<JoinHandle<Result<u64, String>>>,
+    clock: Clock,
     command_address: SocketAddr,
 }
 
@@ -123,22 +129,32 @@ impl Emulator {
             slaves.push(UdpSocket::bind(a).map_err(socket_error(what, a.to_string()))?);
         }
         let stop = Arc::new(AtomicBool::new(false));
-        let (jobs, queue) = mpsc::channel::<Job>();
         let timing = config.timing;
-        let stop_sender = stop.clone();
-        let sender = std::thread::Builder::new()
-            .name("hexadyn-slaves".into())
-            .spawn(move || {
-                realtime_thread(timing.realtime_priority);
-                send_loop(&slaves, &queue, &stop_sender)
-            })
-            .map_err(|e| LinkError::Emulator(format!("cannot start the sender thread: {e}")))?;
+        let clock = options.clock.clone();
+        let (outbox, sender) = match &clock {
+            Clock::Monotonic => {
+                let (jobs, queue) = mpsc::channel::<Datagram>();
+                let stop_sender = stop.clone();
+                let sender = std::thread::Builder::new()
+                    .name("hexadyn-slaves".into())
+                    .spawn(move || {
+                        realtime_thread(timing.realtime_priority);
+                        send_loop(&slaves, &queue, &stop_sender)
+                    })
+                    .map_err(|e| LinkError::Emulator(format!("cannot start the sender thread: {e}")))?;
+                (Outbox::Sender(jobs), Some(sender))
+            }
+            Clock::Virtual(v) => {
+                v.attach(Arc::new(slaves));
+                (Outbox::Virtual(v.clone()), None)
+            }
+        };
         let model = match protocol {
-            Protocol::Motors => spawn_model::<Duty>(robot, s.initial.joints, commands, jobs, stop.clone(), timing, options),
-            Protocol::Servos => spawn_model::<Goal>(robot, s.initial.joints, commands, jobs, stop.clone(), timing, options),
+            Protocol::Motors => spawn_model::<Duty>(robot, s.initial.joints, commands, outbox, stop.clone(), timing, options),
+            Protocol::Servos => spawn_model::<Goal>(robot, s.initial.joints, commands, outbox, stop.clone(), timing, options),
         }
         .map_err(|e| LinkError::Emulator(format!("cannot start the emulator thread: {e}")))?;
-        Ok(Emulator { stop, model: Some(model), sender: Some(sender), command_address })
+        Ok(Emulator { stop, model: Some(model), sender, clock, command_address })
     }
 
     /// The address the emulator listens on for the commands.
@@ -170,7 +186,13 @@ impl Emulator {
             Some(Ok(r)) => r,
             _ => EmulatorReport { error: Some("the emulator thread panicked".into()), ..Default::default() },
         };
+        if let Clock::Virtual(v) = &self.clock {
+            let (sent, error) = v.sent();
+            report.sent = sent;
+            report.error = report.error.or(error);
+        }
         match self.sender.take().map(JoinHandle::join) {
+            None => {}
             Some(Ok(Ok(sent))) => report.sent = sent,
             Some(Ok(Err(e))) => report.error = report.error.or(Some(e)),
             _ => report.error = report.error.or(Some("the sender thread panicked".into())),
@@ -187,25 +209,59 @@ impl Drop for Emulator {
     }
 }
 
-/// A packet due at an instant.
-struct Job {
-    due: Instant,
-    leg: usize,
-    to: SocketAddr,
-    bytes: Vec<u8>,
+/// Where the model thread posts the slave packets, and the slaves' time.
+enum Outbox {
+    /// The sender thread, which sends each packet at its time on the monotonic clock.
+    Sender(Sender<Datagram>),
+    /// The agenda of a virtual clock, sent as its master's time passes.
+    Virtual(Arc<VirtualClock>),
+}
+
+impl Outbox {
+    fn now(&self) -> Instant {
+        match self {
+            Outbox::Sender(_) => Instant::now(),
+            Outbox::Virtual(v) => v.now(),
+        }
+    }
+
+    fn post(&self, d: Datagram) {
+        match self {
+            // The sender outlives the model thread unless it failed; then packets are moot.
+            Outbox::Sender(jobs) => {
+                let _ = jobs.send(d);
+            }
+            Outbox::Virtual(v) => v.schedule(d),
+        }
+    }
+
+    /// The slaves took in a datagram of the command port (a valid command's packets posted).
+    fn taken(&self) {
+        if let Outbox::Virtual(v) = self {
+            v.command_taken();
+        }
+    }
+
+    /// The slaves stopped listening.
+    fn close(&self) {
+        if let Outbox::Virtual(v) = self {
+            v.detach();
+        }
+    }
 }
 
 /// Starts the model thread of the boards of setpoints `S`; servos hold the joint positions
 /// `initial` (the posture the robot settled in) until their first goals.
 #[allow(clippy::too_many_arguments)]
-fn spawn_model<S: Drive>(robot: SimulatedRobot, initial: [f64; JOINTS], commands: UdpSocket, jobs: Sender<Job>, stop: Arc<AtomicBool>, timing: super::config::Timing, options: EmulatorOptions) -> std::io::Result<JoinHandle<EmulatorReport>> {
+fn spawn_model<S: Drive>(robot: SimulatedRobot, initial: [f64; JOINTS], commands: UdpSocket, outbox: Outbox, stop: Arc<AtomicBool>, timing: super::config::Timing, options: EmulatorOptions) -> std::io::Result<JoinHandle<EmulatorReport>> {
     std::thread::Builder::new().name("hexadyn-emulator".into()).spawn(move || {
         // Below the sender: a long model period must not delay the packets.
         let realtime = realtime_thread(timing.realtime_priority.map(|p| p.saturating_sub(1).max(1)));
         let scales = robot.robot.model.encoders.map(|e| JointScale::new(S::PROTOCOL, e));
         let applied = Command { goals: robot.robot.model.takes_references().then_some(initial), references: initial, ..Default::default() };
-        let mut e = Slaves::<S> { robot, scales, applied, faults: FaultInjector::new(options.faults.clone()), report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new(), kind: std::marker::PhantomData };
-        e.serve(&commands, &jobs, &stop, options.idle_timeout);
+        let mut e = Slaves::<S> { robot, scales, applied, faults: FaultInjector::new(options.faults.clone()), outbox, report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new(), kind: std::marker::PhantomData };
+        e.serve(&commands, &stop, options.idle_timeout);
+        e.outbox.close();
         e.finish()
     })
 }
@@ -218,6 +274,7 @@ struct Slaves<S> {
     /// The command the boards apply to the simulated robot (a servo turned off keeps its goal).
     applied: Command,
     faults: FaultInjector,
+    outbox: Outbox,
     report: EmulatorReport,
     last_seq: Option<u16>,
     timing: super::config::Timing,
@@ -228,7 +285,7 @@ struct Slaves<S> {
 }
 
 impl<S: Drive> Slaves<S> {
-    fn serve(&mut self, socket: &UdpSocket, jobs: &Sender<Job>, stop: &AtomicBool, idle_timeout: Option<Duration>) {
+    fn serve(&mut self, socket: &UdpSocket, stop: &AtomicBool, idle_timeout: Option<Duration>) {
         let mut buf = [0u8; 2048];
         let mut last_command: Option<Instant> = None;
         while !stop.load(Ordering::Relaxed) {
@@ -247,31 +304,41 @@ impl<S: Drive> Slaves<S> {
                     return;
                 }
             };
-            let received = Instant::now();
-            let command = match Commands::<S>::decode(&buf[..n]) {
-                Ok(c) => c,
-                Err(e) => {
-                    self.report.rejected.count(&e);
-                    continue;
+            let applied = self.take(&buf[..n], from);
+            self.outbox.taken();
+            if applied {
+                last_command = Some(Instant::now());
+                if let Err(e) = self.step() {
+                    self.report.error = Some(e);
+                    return;
                 }
-            };
-            if let Some(last) = self.last_seq {
-                let d = seq_distance(command.seq, last);
-                if (-REORDER_WINDOW..=0).contains(&d) {
-                    self.report.ignored += 1;
-                    continue;
-                }
-            }
-            last_command = Some(received);
-            if let Err(e) = self.apply(&command, received, from, jobs) {
-                self.report.error = Some(e);
-                return;
             }
         }
     }
 
-    /// Latches and schedules the six packets, then advances the model with the command.
-    fn apply(&mut self, command: &Commands<S>, received: Instant, to: SocketAddr, jobs: &Sender<Job>) -> Result<(), String> {
+    /// Takes in a datagram of the command port as the boards do: a valid new command is applied,
+    /// what it latched posted as the six packets. Returns whether it was applied.
+    fn take(&mut self, bytes: &[u8], from: SocketAddr) -> bool {
+        let command = match Commands::<S>::decode(bytes) {
+            Ok(c) => c,
+            Err(e) => {
+                self.report.rejected.count(&e);
+                return false;
+            }
+        };
+        if let Some(last) = self.last_seq {
+            let d = seq_distance(command.seq, last);
+            if (-REORDER_WINDOW..=0).contains(&d) {
+                self.report.ignored += 1;
+                return false;
+            }
+        }
+        self.apply(&command, self.outbox.now(), from);
+        true
+    }
+
+    /// Latches and posts the six packets, then applies the command to the model.
+    fn apply(&mut self, command: &Commands<S>, received: Instant, to: SocketAddr) {
         self.last_seq = Some(command.seq);
         let state = self.robot.state();
         let q = state.q.as_slice();
@@ -285,8 +352,7 @@ impl<S: Drive> Slaves<S> {
         });
         for (leg, reply) in replies.iter().enumerate() {
             for Outgoing { leg, delay, bytes } in self.faults.apply(leg, n, self.timing.reply_delay(leg), &reply.encode(S::PROTOCOL)) {
-                // The sender outlives this thread unless it failed; then packets are moot.
-                let _ = jobs.send(Job { due: received + delay, leg, to, bytes });
+                self.outbox.post(Datagram { due: received + delay, leg, to, bytes });
             }
         }
         if self.history {
@@ -299,6 +365,10 @@ impl<S: Drive> Slaves<S> {
         }
         self.robot.actuate(&self.applied);
         self.report.commands += 1;
+    }
+
+    /// Advances the model one period with the applied command.
+    fn step(&mut self) -> Result<(), String> {
         let stepping = Instant::now();
         let stepped = self.robot.wait_period();
         self.step_times.push(stepping.elapsed().as_secs_f64());
@@ -315,32 +385,27 @@ impl<S: Drive> Slaves<S> {
     }
 }
 
-/// Sends each packet at its due time until told to stop; returns the datagrams sent. No spin:
-/// the boards themselves answer within ±300 µs (Δt_d, Section 2.3.2).
-fn send_loop(slaves: &[UdpSocket], queue: &Receiver<Job>, stop: &AtomicBool) -> Result<u64, String> {
-    let mut pending: BinaryHeap<Reverse<(Instant, u64)>> = BinaryHeap::new();
-    let mut jobs = std::collections::HashMap::new();
-    let (mut next_id, mut sent) = (0u64, 0u64);
+/// Sends each packet at its due time on the monotonic clock until told to stop; returns the
+/// datagrams sent. No spin: the boards themselves answer within ±300 µs (Δt_d, Section 2.3.2).
+fn send_loop(slaves: &[UdpSocket], queue: &Receiver<Datagram>, stop: &AtomicBool) -> Result<u64, String> {
+    let mut agenda = Agenda::default();
+    let mut sent = 0u64;
     loop {
         // Wait for the next due packet, taking new ones as they come.
-        let wake = pending.peek().map(|Reverse((due, _))| *due);
+        let wake = agenda.next_due();
         let incoming = match wake {
-            Some(due) => {
-                match due.checked_duration_since(Instant::now()) {
-                    Some(wait) if !wait.is_zero() => queue.recv_timeout(wait),
-                    _ => Err(RecvTimeoutError::Timeout),
-                }
-            }
+            Some(due) => match due.checked_duration_since(Instant::now()) {
+                Some(wait) if !wait.is_zero() => queue.recv_timeout(wait),
+                _ => Err(RecvTimeoutError::Timeout),
+            },
             None => queue.recv_timeout(STOP_POLL),
         };
         match incoming {
-            Ok(job) => {
-                pending.push(Reverse((job.due, next_id)));
-                jobs.insert(next_id, job);
-                next_id += 1;
+            Ok(d) => {
+                agenda.push(d);
                 continue;
             }
-            Err(RecvTimeoutError::Disconnected) if pending.is_empty() => return Ok(sent),
+            Err(RecvTimeoutError::Disconnected) if agenda.is_empty() => return Ok(sent),
             Err(_) if wake.is_none() => {
                 if stop.load(Ordering::Relaxed) {
                     return Ok(sent);
@@ -349,10 +414,11 @@ fn send_loop(slaves: &[UdpSocket], queue: &Receiver<Job>, stop: &AtomicBool) -> 
             }
             Err(_) => {}
         }
-        let Some(Reverse((due, id))) = pending.pop() else { continue };
+        let Some(due) = wake else { continue };
         sleep_until(due, Duration::ZERO);
-        let job = jobs.remove(&id).ok_or("a scheduled packet vanished")?;
-        slaves[job.leg].send_to(&job.bytes, job.to).map_err(|e| format!("slave {} could not send to {}: {e}", job.leg, job.to))?;
-        sent += 1;
+        while let Some(d) = agenda.pop_due(due) {
+            d.send(slaves)?;
+            sent += 1;
+        }
     }
 }

@@ -2,9 +2,10 @@
 //! Fig. 2.17). At each deadline of an absolute monotonic clock the master broadcasts the 18
 //! setpoints (motor duties, or servo goals: the master is generic over the [`Setpoint`]), then
 //! collects the six slave packets; the period is complete when the last
-//! one arrives, and the controller runs at once (in [`super::UdpPlant`]). Waiting is precise
-//! ([`super::clock::wait_readable`]): `ppoll` up to the deadline minus a spin margin, then a
-//! spin.
+//! one arrives, and the controller runs at once (in [`super::UdpPlant`]). On the robot, waiting
+//! is precise ([`super::clock::wait_readable`]): `ppoll` up to the deadline minus a spin
+//! margin, then a spin. On a [`Clock::Virtual`] the same loop runs in lock-step with emulated
+//! slaves ([`super::virtual_clock`]): the same packets, sockets and checks, in virtual time.
 //!
 //! Freshness: a slave packet is used only if it comes from the configured address of its leg,
 //! decodes (size, CRC, version, ranges), names that leg and echoes the sequence number of the
@@ -21,7 +22,7 @@ use std::net::{SocketAddr, UdpSocket};
 use std::os::fd::AsRawFd;
 use std::time::{Duration, Instant};
 
-use super::clock::{wait_readable, Wake};
+use super::clock::{Clock, Wake};
 use super::config::LinkConfig;
 use super::protocol::{seq_distance, Commands, PacketErrorCounts, Setpoint, SlaveReply, COMMAND_SIZE};
 use super::LinkError;
@@ -108,6 +109,7 @@ impl LinkStats {
 pub struct Master<S: Setpoint> {
     socket: UdpSocket,
     config: LinkConfig,
+    clock: Clock,
     /// Index of the current period (the last broadcast at a deadline).
     period: u64,
     started: bool,
@@ -123,16 +125,18 @@ pub struct Master<S: Setpoint> {
 }
 
 impl<S: Setpoint> Master<S> {
-    /// Binds the master socket (broadcast allowed); the clock starts with [`Self::start_clock`].
-    pub fn bind(config: &LinkConfig) -> Result<Self, LinkError> {
+    /// Binds the master socket (broadcast allowed); the deadlines on `clock` start with
+    /// [`Self::start_clock`].
+    pub fn bind(config: &LinkConfig, clock: Clock) -> Result<Self, LinkError> {
         let socket_error = |source| LinkError::Socket { what: "cannot open the master socket", address: config.master.to_string(), source };
         let socket = UdpSocket::bind(config.master).map_err(socket_error)?;
         socket.set_broadcast(true).map_err(socket_error)?;
         socket.set_nonblocking(true).map_err(socket_error)?;
-        let now = Instant::now();
+        let now = clock.now();
         Ok(Master {
             socket,
             config: config.clone(),
+            clock,
             period: 0,
             started: false,
             next_deadline: now,
@@ -157,7 +161,7 @@ impl<S: Setpoint> Master<S> {
 
     /// The first deadline is one period from now.
     pub fn start_clock(&mut self) {
-        self.next_deadline = Instant::now() + self.config.timing.period;
+        self.next_deadline = self.clock.now() + self.config.timing.period;
     }
 
     /// Index of the current period.
@@ -224,7 +228,7 @@ impl<S: Setpoint> Master<S> {
     /// The start: broadcasts the zero command every period until the six slaves answer in one period, for
     /// at most the configured connect timeout (a missing slave is no safety stop yet).
     pub fn connect(&mut self) -> Result<[SlaveReply; LEG_COUNT], LinkError> {
-        let give_up = Instant::now() + self.config.safety.connect_timeout;
+        let give_up = self.clock.now() + self.config.safety.connect_timeout;
         loop {
             self.wait(self.next_deadline)?;
             self.broadcast(&[S::default(); JOINTS])?;
@@ -233,7 +237,7 @@ impl<S: Setpoint> Master<S> {
                 self.stats.complete_periods += 1;
                 return Ok([a, b, c, d, e, f]);
             }
-            if Instant::now() >= give_up {
+            if self.clock.now() >= give_up {
                 self.stop();
                 let legs = (0..LEG_COUNT).filter(|&l| self.replies[l].is_none()).collect();
                 return Err(LinkError::NoAnswer { legs, timeout_s: self.config.safety.connect_timeout.as_secs_f64(), broadcast: self.config.broadcast.to_string() });
@@ -244,7 +248,7 @@ impl<S: Setpoint> Master<S> {
     /// Stops the robot if the next deadline has passed (the controller overran); call when the
     /// controller's command is ready.
     pub fn check_overrun(&mut self) -> Result<(), LinkError> {
-        let now = Instant::now();
+        let now = self.clock.now();
         if self.started && now > self.next_deadline + self.config.safety.overrun_tolerance {
             let late_s = (now - self.next_deadline).as_secs_f64();
             return Err(self.safety_stop(StopReason::Overrun { late_s }));
@@ -270,8 +274,9 @@ impl<S: Setpoint> Master<S> {
         let seq = if self.started { self.period.wrapping_add(1) as u16 } else { 0 };
         let bytes = Commands::<S>::zero(seq).encode();
         for _ in 0..STOP_REPEATS {
-            if let Err(e) = self.socket.send_to(&bytes, self.config.broadcast) {
-                self.event(format!("the stop command could not be sent: {e}"));
+            match self.socket.send_to(&bytes, self.config.broadcast) {
+                Ok(_) => self.clock.command_sent(),
+                Err(e) => self.event(format!("the stop command could not be sent: {e}")),
             }
         }
     }
@@ -279,7 +284,7 @@ impl<S: Setpoint> Master<S> {
     /// Reads and counts what still arrives during `duration` (after a stop: the slaves' late
     /// packets and their answers to the stop command), so that the counters see every packet.
     pub fn linger(&mut self, duration: Duration) {
-        let until = Instant::now() + duration;
+        let until = self.clock.now() + duration;
         while let Ok(Wake::Readable) = self.poll(until) {
             self.drain();
         }
@@ -298,7 +303,7 @@ impl<S: Setpoint> Master<S> {
     }
 
     fn poll(&self, deadline: Instant) -> Result<Wake, LinkError> {
-        wait_readable(self.socket.as_raw_fd(), deadline, self.config.timing.spin).map_err(|source| LinkError::Socket { what: "cannot poll the master socket", address: self.config.master.to_string(), source })
+        self.clock.wait_readable(self.socket.as_raw_fd(), deadline, self.config.timing.spin).map_err(|source| LinkError::Socket { what: "cannot poll the master socket", address: self.config.master.to_string(), source })
     }
 
     fn broadcast(&mut self, setpoints: &[S; JOINTS]) -> Result<(), LinkError> {
@@ -306,8 +311,9 @@ impl<S: Setpoint> Master<S> {
             self.period += 1;
         }
         let bytes: [u8; COMMAND_SIZE] = Commands { seq: self.period as u16, setpoints: *setpoints }.encode();
-        let now = Instant::now();
+        let now = self.clock.now();
         self.socket.send_to(&bytes, self.config.broadcast).map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
+        self.clock.command_sent();
         let deadline = self.next_deadline;
         self.stats.lateness.push(now.saturating_duration_since(deadline).as_secs_f64());
         self.stats.broadcasts += 1;
@@ -336,7 +342,8 @@ impl<S: Setpoint> Master<S> {
         loop {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
-                    let at = Instant::now();
+                    self.clock.datagram_received();
+                    let at = self.clock.now();
                     self.receive(&buf[..n], from, at);
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return,

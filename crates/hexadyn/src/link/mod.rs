@@ -7,7 +7,8 @@
 //!   DC motors (PWM duties, encoder counts) or position servos (goals, present positions);
 //! - [`drive`]: a joint's counts and setpoints in the controller's units;
 //! - [`config`]: the link configuration file (addresses, period, Fig. 2.21 timing, safety);
-//! - [`clock`]: precise waits on the monotonic clock for the deadline loop;
+//! - [`clock`]: the clock of the deadline loop, monotonic (precise waits) or virtual (the master
+//!   and the emulator in lock-step, [`virtual_clock`]);
 //! - [`master`]: the deadline loop, packet freshness and the safety stops;
 //! - [`UdpPlant`]: the robot behind the link as a [`crate::control::Plant`];
 //! - [`emulator`]: six slaves answering like the boards, backed by the simulated robot, with
@@ -18,6 +19,7 @@
 //! The link sits above [`crate::scenario`]: it runs a scenario's controller, and the emulator
 //! the scenario's simulated robot.
 
+mod agenda;
 pub mod clock;
 pub mod config;
 pub mod drive;
@@ -27,6 +29,7 @@ pub mod master;
 pub mod protocol;
 pub mod run;
 mod udp_plant;
+pub mod virtual_clock;
 
 pub use config::{ConfigError, LinkConfig, Safety, Timing};
 pub use master::{SafetyStop, StopReason};

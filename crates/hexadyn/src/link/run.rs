@@ -38,7 +38,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::clock::{realtime_thread, Percentiles};
+use super::clock::{realtime_thread, Clock, Percentiles};
 use super::config::LinkConfig;
 use super::drive::{Drive, JointScale};
 use super::master::{LinkEvent, LinkStats, SafetyStop};
@@ -155,8 +155,9 @@ impl RunHandle {
     }
 }
 
-/// Starts the run on a dedicated master thread.
-pub fn spawn_robot_run(s: Scenario, config: LinkConfig) -> Result<RunHandle, LinkError> {
+/// Starts the run on a dedicated master thread, its deadlines on `clock` (the robot:
+/// [`Clock::Monotonic`]).
+pub fn spawn_robot_run(s: Scenario, config: LinkConfig, clock: Clock) -> Result<RunHandle, LinkError> {
     let protocol = check(&s, &config)?;
     let periods = Arc::new(AtomicU64::new(0));
     let interrupt = Arc::new(AtomicBool::new(false));
@@ -165,17 +166,18 @@ pub fn spawn_robot_run(s: Scenario, config: LinkConfig) -> Result<RunHandle, Lin
     let thread = std::thread::Builder::new()
         .name("hexadyn-master".into())
         .spawn(move || match protocol {
-            Protocol::Motors => master_thread::<Duty>(&s, &config, &p, i),
-            Protocol::Servos => master_thread::<Goal>(&s, &config, &p, i),
+            Protocol::Motors => master_thread::<Duty>(&s, &config, clock, &p, i),
+            Protocol::Servos => master_thread::<Goal>(&s, &config, clock, &p, i),
         })
         .map_err(|e| LinkError::Emulator(format!("cannot start the master thread: {e}")))?;
     Ok(RunHandle { thread, periods, interrupt, period })
 }
 
-/// Runs the scenario's controller on the robot and waits for the end; `progress` is called
-/// with the time of the last measurements about every 50 ms and may stop the run.
-pub fn run_robot(s: &Scenario, config: &LinkConfig, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<RobotRun, LinkError> {
-    let handle = spawn_robot_run(s.clone(), config.clone())?;
+/// Runs the scenario's controller on the robot, deadlines on `clock`, and waits for the end;
+/// `progress` is called with the time of the last measurements about every 50 ms and may stop
+/// the run.
+pub fn run_robot(s: &Scenario, config: &LinkConfig, clock: Clock, mut progress: impl FnMut(f64) -> ControlFlow<()>) -> Result<RobotRun, LinkError> {
+    let handle = spawn_robot_run(s.clone(), config.clone(), clock)?;
     while !handle.is_finished() {
         std::thread::sleep(PROGRESS_INTERVAL);
         if progress(handle.t()).is_break() {
@@ -185,7 +187,7 @@ pub fn run_robot(s: &Scenario, config: &LinkConfig, mut progress: impl FnMut(f64
     handle.join()
 }
 
-fn master_thread<S: Drive>(s: &Scenario, config: &LinkConfig, periods: &AtomicU64, interrupt: Arc<AtomicBool>) -> Result<RobotRun, LinkError> {
+fn master_thread<S: Drive>(s: &Scenario, config: &LinkConfig, clock: Clock, periods: &AtomicU64, interrupt: Arc<AtomicBool>) -> Result<RobotRun, LinkError> {
     let started = Instant::now();
     let realtime = realtime_thread(config.timing.realtime_priority);
     // Everything is built before the link starts: the first deadline must not wait on it.
@@ -197,7 +199,7 @@ fn master_thread<S: Drive>(s: &Scenario, config: &LinkConfig, periods: &AtomicU6
     let servos = S::PROTOCOL == Protocol::Servos;
     let mut row = Row { rec: Recorder::default(), joints: s.robot.joints().clone(), gait, pi, servos, resistance, last_t: None, e_el: [0.0; JOINTS], e_joule: [0.0; JOINTS], max_voltage: 0.0, saturated: 0, commands: 0, tracking: [0.0; 3] };
     let scales = parts.encoders.map(|e| JointScale::new(S::PROTOCOL, e));
-    let mut plant = UdpPlant::<S>::connect(config, scales, interrupt)?;
+    let mut plant = UdpPlant::<S>::connect(config, clock, scales, interrupt)?;
     // As many controller updates as in a simulation: the controllers count their updates (the
     // gait integrates its body reference by Δt per update), so a missed period, which runs no
     // update, lengthens the run by one period.

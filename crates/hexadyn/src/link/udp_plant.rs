@@ -20,6 +20,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::clock::Clock;
 use super::config::LinkConfig;
 use super::drive::{Drive, JointScale};
 use super::master::{LinkEvent, LinkStats, Master, StopReason};
@@ -63,11 +64,11 @@ pub struct UdpPlant<S: Drive> {
 }
 
 impl<S: Drive> UdpPlant<S> {
-    /// Opens the link and waits for the six slaves (the zero command broadcast until they all
-    /// answer); `scales`: the joints' position counts. `interrupt` stops the robot at the next
-    /// period when set.
-    pub fn connect(config: &LinkConfig, scales: [JointScale; JOINTS], interrupt: Arc<AtomicBool>) -> Result<Self, LinkError> {
-        let mut master = Master::bind(config)?;
+    /// Opens the link with deadlines on `clock` and waits for the six slaves (the zero command
+    /// broadcast until they all answer); `scales`: the joints' position counts. `interrupt`
+    /// stops the robot at the next period when set.
+    pub fn connect(config: &LinkConfig, clock: Clock, scales: [JointScale; JOINTS], interrupt: Arc<AtomicBool>) -> Result<Self, LinkError> {
+        let mut master = Master::bind(config, clock)?;
         master.start_clock();
         let replies = master.connect()?;
         let mut plant = UdpPlant {
