@@ -137,18 +137,22 @@ fn a_silent_slave_stops_the_robot_within_3_periods_at_0_v() {
     assert_rows_are_fresh(&s, &run, &report);
 }
 
+/// Corrupted and wrong-size packets are counted exactly and never reach the controller, on
+/// AMRU5's motor packets and on the PhantomX's servo packets.
 #[test]
 fn corrupted_and_wrong_size_packets_are_counted_and_never_reach_the_controller() {
-    let s = scenario("validation_tripod_1_5cm", 6.0);
-    let faults = Faults { corrupt: 0.05, wrong_size: 0.03, seed: 9, ..Default::default() };
-    let (run, report) = linked(&s, faults, RIDE_THROUGH);
-    let run = run.expect("walk with corrupted packets");
-    assert!(run.stop.is_none(), "{:?}", run.stop);
-    assert!(report.faults.corrupted > 50 && report.faults.wrong_size > 30, "{:?}", report.faults);
-    assert_eq!(run.stats.rejected.checksum, report.faults.corrupted);
-    assert_eq!(run.stats.rejected.size, report.faults.wrong_size);
-    assert_eq!(run.stats.rejected.version + run.stats.rejected.range + run.stats.wrong_leg, 0);
-    assert_rows_are_fresh(&s, &run, &report);
+    for (name, duration, seed, least) in [("validation_tripod_1_5cm", 6.0, 9, (50, 30)), ("phantomx_tripod", 4.0, 3, (30, 20))] {
+        let s = scenario(name, duration);
+        let faults = Faults { corrupt: 0.05, wrong_size: 0.03, seed, ..Default::default() };
+        let (run, report) = linked(&s, faults, RIDE_THROUGH);
+        let run = run.expect("walk with corrupted packets");
+        assert!(run.stop.is_none(), "{name}: {:?}", run.stop);
+        assert!(report.faults.corrupted > least.0 && report.faults.wrong_size > least.1, "{name}: {:?}", report.faults);
+        assert_eq!(run.stats.rejected.checksum, report.faults.corrupted, "{name}");
+        assert_eq!(run.stats.rejected.size, report.faults.wrong_size, "{name}");
+        assert_eq!(run.stats.rejected.version + run.stats.rejected.range + run.stats.wrong_leg, 0, "{name}");
+        assert_rows_are_fresh(&s, &run, &report);
+    }
 }
 
 #[test]
@@ -230,21 +234,6 @@ fn phantomx_stand_and_tripod_through_master_and_emulator_end_near_the_simulation
             assert!(end[0] > 0.12, "the simulated walk covers 15 cm, got {}", end[0]);
         }
     }
-}
-
-/// Corrupted and wrong-size servo packets are counted exactly and never reach the controller.
-#[test]
-fn corrupted_servo_packets_are_counted_and_never_reach_the_controller() {
-    let s = scenario("phantomx_tripod", 4.0);
-    let faults = Faults { corrupt: 0.05, wrong_size: 0.03, seed: 3, ..Default::default() };
-    let (run, report) = linked(&s, faults, RIDE_THROUGH);
-    let run = run.expect("walk with corrupted packets");
-    assert!(run.stop.is_none(), "{:?}", run.stop);
-    assert!(report.faults.corrupted > 30 && report.faults.wrong_size > 20, "{:?}", report.faults);
-    assert_eq!(run.stats.rejected.checksum, report.faults.corrupted);
-    assert_eq!(run.stats.rejected.size, report.faults.wrong_size);
-    assert_eq!(run.stats.rejected.version + run.stats.rejected.range + run.stats.wrong_leg, 0);
-    assert_rows_are_fresh(&s, &run, &report);
 }
 
 /// The servo boards reject motor commands, forged and corrupted commands with a counted
