@@ -194,6 +194,19 @@ def state(page) -> dict:
     return {"t": float(el.get_attribute("data-t")), "feet": np.array(json.loads(el.get_attribute("data-feet")))}
 
 
+def seek_foot_error(page, folder: Path, t: float) -> float:
+    """Seeks the page to `t` with its own time input, as a user types a time, and returns the
+    largest distance (m) between the feet it shows and those recorded in `folder` at `t`."""
+    box = page.locator("input.mantine-NumberInput-input").first  # the number box of the time slider
+    box.fill(str(t))
+    box.press("Enter")
+    wait_for(lambda: abs(state(page)["t"] - t) < 1e-9, what=f"the page to show t = {t}")
+    table = pq.read_table(folder / "timeseries.parquet", columns=["t", *FOOT_COLUMNS])
+    row = int(np.argmin(np.abs(table.column("t").to_numpy() - t)))
+    recorded = np.array([table.column(c)[row].as_py() for c in FOOT_COLUMNS]).reshape(6, 3)
+    return float(np.abs(state(page)["feet"] - recorded).max())
+
+
 def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder, browser, tmp_path):
     page = browser.new_page(viewport=VIEWPORT)
     page.add_init_script(FRAME_COUNTER_JS)
@@ -203,16 +216,8 @@ def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder,
     time.sleep(2.0)
     assert_scene_drawn(canvas_png(page, tmp_path / "live.png"), "live page")
 
-    # Seek with the page's own time input, as a user types a time.
     t = 13.37
-    box = page.locator("input.mantine-NumberInput-input").first  # the number box of the time slider
-    box.fill(str(t))
-    box.press("Enter")
-    wait_for(lambda: abs(state(page)["t"] - t) < 1e-9, what=f"the page to show t = {t}")
-    table = pq.read_table(walk_folder / "timeseries.parquet", columns=["t", *FOOT_COLUMNS])
-    row = int(np.argmin(np.abs(table.column("t").to_numpy() - t)))
-    recorded = np.array([table.column(c)[row].as_py() for c in FOOT_COLUMNS]).reshape(6, 3)
-    error = np.abs(state(page)["feet"] - recorded).max()
+    error = seek_foot_error(page, walk_folder, t)
     print(f"\nfoot position error at t = {t} s: {error:.2e} m")
     assert error < 1e-6
 
@@ -234,6 +239,7 @@ def test_view_page_draws_seeks_to_the_recorded_feet_and_plays(live, walk_folder,
     # Follow the body: the camera keeps its offset and looks at the body as time moves.
     page.get_by_label("Follow body").check()
     wait_for(lambda: live.viewer.follow.value, what="the follow box to reach the viewer")
+    box = page.locator("input.mantine-NumberInput-input").first
     box.fill("5")
     box.press("Enter")
     wait_for(lambda: abs(state(page)["t"] - 5.0) < 1e-9, what="the page to show t = 5")

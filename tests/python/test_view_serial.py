@@ -8,7 +8,6 @@ absent, these tests fail: they do not skip)."""
 from __future__ import annotations
 
 import base64
-import json
 import re
 import shutil
 import time
@@ -17,7 +16,6 @@ from pathlib import Path
 
 import msgspec
 import numpy as np
-import pyarrow.parquet as pq
 import pytest
 import zstandard
 from click.testing import CliRunner
@@ -28,10 +26,10 @@ import hexadyn
 from hexadyn import _core, report
 from hexadyn.view import scene as view_scene
 from hexadyn.view.command import view
-from hexadyn.view.data import FOOT_COLUMNS, Run
+from hexadyn.view.data import Run
 from hexadyn.view.export import frame_indices
 from hexadyn.view.measure import HEADLESS_CHROMIUM_ARGS
-from test_view import wait_for
+from test_view import seek_foot_error, wait_for
 
 VIEWPORT = {"width": 1280, "height": 800}
 #: The PhantomX's joints (robots/phantomx/phantomx.toml, joints.names).
@@ -250,11 +248,6 @@ def link_mask(image: np.ndarray) -> np.ndarray:
     return (r - b > 0.25) & (g > 0.3) & (r > 0.5)
 
 
-def state(page) -> dict:
-    el = page.locator("#hexadyn-state")
-    return {"t": float(el.get_attribute("data-t")), "feet": np.array(json.loads(el.get_attribute("data-feet")))}
-
-
 def test_serial_page_draws_the_legs_and_seeks_to_the_recorded_feet(px_folder, browser, tmp_path):
     from hexadyn.view.server import start
 
@@ -269,15 +262,7 @@ def test_serial_page_draws_the_legs_and_seeks_to_the_recorded_feet(px_folder, br
         print(f"\nlink pixels at the start: {share:.4f}")
         assert share > 1e-3, "no leg link in view"
 
-        t = 1.73
-        box = page.locator("input.mantine-NumberInput-input").first
-        box.fill(str(t))
-        box.press("Enter")
-        wait_for(lambda: abs(state(page)["t"] - t) < 1e-9, what=f"the page to show t = {t}")
-        table = pq.read_table(px_folder / "timeseries.parquet", columns=["t", *FOOT_COLUMNS])
-        row = int(np.argmin(np.abs(table.column("t").to_numpy() - t)))
-        recorded = np.array([table.column(c)[row].as_py() for c in FOOT_COLUMNS]).reshape(6, 3)
-        assert np.abs(state(page)["feet"] - recorded).max() < 1e-6
+        assert seek_foot_error(page, px_folder, 1.73) < 1e-6
         time.sleep(1.0)
         after = canvas_png(page, tmp_path / "later.png")
         assert float(np.mean(link_mask(after))) > 1e-3
