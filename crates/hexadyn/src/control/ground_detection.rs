@@ -122,8 +122,8 @@ impl<L: GroundSensingLeg> GroundDetector<L> {
 
     /// One control period: Eq. 5.14-5.16 and 5.22 for every leg from the measurements.
     pub fn update(&mut self, m: &Measurements) -> [LegDetection; LEG_COUNT] {
-        let friction = self.estimator.dry_viscous();
-        let e = self.estimator.update(m);
+        self.estimator.update(m);
+        let (e, friction) = (self.estimator.estimate().expect("just updated"), self.estimator.dry_viscous());
         std::array::from_fn(|leg| {
             let k = 3 * leg;
             let q = leg_joints(e, leg);

@@ -86,8 +86,8 @@ impl TorqueEstimator {
     }
 
     /// The dry/viscous law of each joint (Eq. 6.1), k = 3 leg + j.
-    pub fn dry_viscous(&self) -> [DryViscous; JOINTS] {
-        self.friction
+    pub fn dry_viscous(&self) -> &[DryViscous; JOINTS] {
+        &self.friction
     }
 
     /// The estimate of the last update.

@@ -549,7 +549,8 @@ impl LandingDefaults {
     /// and halts after 0.10 m. The currents' 40 N scale the same way (2.1 N on the PhantomX, a
     /// third of a tripod leg's 6 N load; AMRU5's 40 N is 40 % of its 100 N, Section 5.6.3).
     fn weighted(robot: &Robot) -> LandingDefaults {
-        let weighted = |threshold: f64| threshold * robot.total_mass_kg() / crate::description::RobotDescription::amru5().total_mass_kg();
+        let (mass, amru5_mass) = (robot.total_mass_kg(), crate::description::RobotDescription::amru5().total_mass_kg());
+        let weighted = |threshold: f64| threshold * mass / amru5_mass;
         LandingDefaults { force: weighted(THESIS_FORCE_THRESHOLD), current: weighted(THESIS_CURRENT_THRESHOLD) }
     }
 }
