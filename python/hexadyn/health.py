@@ -14,6 +14,8 @@ catch what a reader of the figures would catch:
 - the body falling (``body_height_change_m`` against ``initial_body_height_m``);
 - walking, the XY tracking error of the body against the scale of the scenario (the reference
   distance) and the distance walked against the reference;
+- the free gait's stability margin (``min_stability_margin_m``): below zero the body's centre
+  was beyond an edge of the feet in support, −∞ fewer than three feet were in support;
 - any non-finite figure.
 
 The thresholds are stated with their reasons next to them; every shipped scenario passes them
@@ -66,7 +68,8 @@ RATIOS = ("specific_resistance", "friction_share", "joule_share")
 def check(summary: Mapping[str, Any]) -> list[str]:
     """The failed health checks of a run's summary, one line each (empty: healthy)."""
     warnings = []
-    bad = [k for k, v in summary.items() if isinstance(v, float) and not math.isfinite(v) and k not in RATIOS]
+    margin, when = summary.get("min_stability_margin_m"), summary.get("min_stability_margin_t_s")
+    bad = [k for k, v in summary.items() if isinstance(v, float) and not math.isfinite(v) and k not in RATIOS and not (k == "min_stability_margin_m" and v == -math.inf)]
     if bad:
         warnings.append(f"non-finite figures: {', '.join(bad)}")
     balance = summary.get("energy_balance_error_relative")
@@ -93,6 +96,10 @@ def check(summary: Mapping[str, Any]) -> list[str]:
         allowed = TRACKING_ALLOWANCE_M + MAX_DISTANCE_FRACTION * reference
         if _finite(walked) and abs(walked - reference) > allowed:
             warnings.append(f"the body walked {walked:.3f} m for a {reference:.3f} m reference (allowed difference {allowed:.3f} m)")
+    if margin == -math.inf:
+        warnings.append(f"fewer than three feet were in support at t = {when:.2f} s (free gait): the robot stood on no support polygon")
+    elif _finite(margin) and margin < 0:
+        warnings.append(f"the stability margin fell to {margin * 1e3:.1f} mm at t = {when:.2f} s (free gait): the body's centre was beyond an edge of the feet in support")
     return warnings
 
 

@@ -103,7 +103,9 @@ __all__ = [
     "ground_detection_figure",
     "joint_figure",
     "parse_legs",
+    "posture_figure",
     "save_figures",
+    "stability_figure",
     "style",
     "trajectory_figure",
 ]
@@ -295,6 +297,30 @@ def posture_figure(results: Results) -> Figure:
     return fig
 
 
+def stability_figure(results: Results) -> Figure:
+    """The free gait's tip-over stability against time (beyond the thesis): the normalized
+    energy stability margin of the feet in support as the controller knows them (the
+    ``stability_margin`` column, mm); below zero the body's centre is beyond an edge of its
+    support polygon, and it is not drawn with fewer than three feet in support."""
+    ts = results.timeseries
+    if "stability_margin" not in ts.columns:
+        raise ValueError("stability: these results have no stability_margin column (not a free gait scenario)")
+    t = ts.index.to_numpy()
+    margin = ts["stability_margin"].to_numpy() * 1e3
+    with style():
+        fig = Figure(figsize=(6.3, 2.8))
+        ax = fig.subplots()
+        ax.plot(t, np.where(np.isfinite(margin), margin, np.nan), color=SIMULATED, label="energy stability margin")
+        ax.axhline(0.0, color=REFERENCE, linestyle=":", label="tip-over")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("margin [mm]")
+        ax.legend(loc="best", frameon=False)
+        finite = margin[np.isfinite(margin)]
+        lowest = f", smallest {finite.min():.1f} mm" if finite.size else ""
+        fig.suptitle(f"{_title(results)}: stability margin{lowest}")
+    return fig
+
+
 def averaged_power_figure(results: Results) -> Figure:
     """Averaged power per actuator (W), stacked by foot phase when the robot walks."""
     table = energy.averaged_power(results)
@@ -383,7 +409,7 @@ def _check_leg(leg: int) -> None:
 
 def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, Figure]:
     """The figures the results support, by file stem: ``leg0_q_r`` ... for the given legs, then
-    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``posture`` (free gait),
+    ``gait_diagram`` and ``trajectory`` (walking scenarios), ``posture`` and ``stability`` (free gait),
     ``averaged_power`` and ``energy_breakdown``."""
     for leg in legs:
         _check_leg(leg)
@@ -394,6 +420,8 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
         out["trajectory"] = trajectory_figure(results)
     if "body_clearance" in results.timeseries.columns:
         out["posture"] = posture_figure(results)
+    if "stability_margin" in results.timeseries.columns:
+        out["stability"] = stability_figure(results)
     out["averaged_power"] = averaged_power_figure(results)
     out["energy_breakdown"] = energy_breakdown_figure(results)
     if ground_detection.has_experiment(results):

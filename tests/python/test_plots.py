@@ -131,3 +131,18 @@ def test_gait_diagram_and_viewer_know_a_failed_leg(walk: Results):
     for code in vocabulary.PHASE_CODES.values():
         assert code in charts.GAIT_LEVEL and code in scene.PHASE_COLOURS, code
     assert len(set(scene.PHASE_COLOURS[c] for c in vocabulary.PHASE_CODES.values())) == len(vocabulary.PHASE_CODES)
+
+
+def test_free_gait_stability_figure(tmp_path: Path):
+    """A free gait run has the stability figure: the `stability_margin` column in mm against
+    time, the smallest value (the summary's) in its title, and a drawn PNG."""
+    r = hexadyn.simulate(shortened("free_gait_straight", tmp_path, 12.0), tmp_path / "out", progress=False)
+    figures = report.plot(r, tmp_path / "plots", legs=[])
+    assert {"posture", "stability"} <= set(figures)
+    line = figures["stability"].axes[0].get_lines()[0]
+    margin = r.timeseries["stability_margin"].to_numpy()
+    assert line.get_xdata() == pytest.approx(r.timeseries.index.to_numpy())
+    assert line.get_ydata() == pytest.approx(margin * 1e3)
+    assert f"smallest {r.summary['min_stability_margin_m'] * 1e3:.1f} mm" in figures["stability"]._suptitle.get_text()
+    assert 0.0 < r.summary["min_stability_margin_m"] == margin.min()
+    assert_drawn(tmp_path / "plots" / "stability.png", [plots.SIMULATED], width_in=6.3)

@@ -227,12 +227,15 @@ def test_health_checks_flag_meaningless_runs():
         ({"tracking_error_xy_max_m": 1.0}, "strayed 1.000 m"),
         ({"distance_walked_m": 282.0}, "walked 282.000 m for a 0.900 m reference"),
         ({"energy_electrical_j": float("nan")}, "non-finite figures: energy_electrical_j"),
+        ({"min_stability_margin_m": -0.004, "min_stability_margin_t_s": 12.5}, "stability margin fell to -4.0 mm at t = 12.50 s"),
+        ({"min_stability_margin_m": float("-inf"), "min_stability_margin_t_s": 3.0}, "fewer than three feet were in support at t = 3.00 s"),
     ]:
         warnings = health.check({**healthy, **change})
         assert len(warnings) == 1 and words in warnings[0], (change, warnings)
     # Without electrical energy (unpowered) the shares of it are 0/0: not applicable.
     unpowered = {**healthy, "energy_electrical_j": 0.0, "friction_share": float("nan"), "joule_share": float("nan"), "specific_resistance": float("nan")}
     assert health.check(unpowered) == []
+    assert health.check({**healthy, "min_stability_margin_m": 0.003, "min_stability_margin_t_s": 1.0}) == []
 
 
 def test_strict_turns_warnings_into_an_exit_status(tmp_path: Path, monkeypatch):

@@ -78,7 +78,7 @@ fn main() {
     let legs = LegKinematics::hexapod_from_description(&d).unwrap();
     let height = -legs[0].foot(&Vector3::new(0.0, 0.06, 0.035)).z;
     let workspaces: [_; 6] = std::array::from_fn(|l| legs[l].workspace_for_body_height(height, 0.045).unwrap());
-    let options = FreeGaitOptions { body_height: height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg: None, stability_margin: 0.02, dt: 0.01, elevator: Some(THESIS_CURRENT_THRESHOLD) };
+    let options = FreeGaitOptions { body_height: height, lift: 0.045, takeoff_time: 1.0, swing_time: 3.0, posture_time: 2.0, failed_leg: None, stability_margin: 0.02, energy_margin: 0.0, dt: 0.01, elevator: Some(THESIS_CURRENT_THRESHOLD) };
     let mut free = FreeGaitController::new(options, legs.clone(), workspaces, joint_pis(&d.joint_pi_gains(), 0.01), Box::new(Constant(Heading::new(0.01, 0.0, 0.0))), Box::new(NormalForce { threshold: THESIS_FORCE_THRESHOLD }));
     let mut m = Measurements { t: 0.0, positions: joints_at_workspace_centres(&legs, &workspaces, height).unwrap(), currents: [0.0; JOINTS], supply_voltage: 12.0, pose: None, foot_normal_forces: Some([100.0; 6]) };
     let (mut plain, mut posture) = (Vec::new(), Vec::new());

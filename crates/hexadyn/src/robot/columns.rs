@@ -28,6 +28,7 @@
 //! | `posture_roll`, `posture_pitch` | rad | body roll and pitch as the free gait knows them (navigation, else desired) |
 //! | `touchdown[l]` | 1 | 1 when the landing of leg l was detected at t (free gait) |
 //! | `deadlock` | 1 | 1 while the support legs are halted (free gait, Section 7.7.4) |
+//! | `stability_margin` | m | normalized energy stability margin of the feet in support as the free gait knows them (beyond the thesis; −inf below three feet) |
 //! | `u_q_v[i]` ... | V | voltage across motor + H-bridge (after saturation and limit switches) |
 //! | `i_q_v[i]` ... | A | motor current |
 //! | `i_meas_q_v[i]` ... | A | motor current as the controller measured it at t: through the analog 30 Hz filter, with the sensor noise (Section 5.6.2, [`crate::physics::CurrentSensors`]) |
@@ -159,6 +160,7 @@ pub fn record_gait(rec: &mut Recorder, g: &GaitState) {
             rec.put(f64::from(u8::from(*t)), || (format!("touchdown[{l}]"), "1", s("1 when the landing of the leg was detected at t (free gait)")));
         }
         rec.put(f64::from(u8::from(free.deadlock)), || (s("deadlock"), "1", s("1 while the support legs are halted by a deadlock (free gait, Section 7.7.4)")));
+        rec.put(free.stability_margin, || (s("stability_margin"), "m", s("normalized energy stability margin of the feet in support as the free gait knows them: the rise of the centre of mass to tip over the weakest edge (< 0: beyond it)")));
     }
 }
 

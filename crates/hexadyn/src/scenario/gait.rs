@@ -115,6 +115,7 @@ struct RawFree {
     landing_threshold_n: Option<f64>,
     failed_leg: Option<i64>,
     stability_margin_m: Option<f64>,
+    energy_margin_m: Option<f64>,
     elevator: Option<bool>,
 }
 
@@ -527,6 +528,13 @@ pub const DEFAULT_POSTURE_TIME_S: f64 = 2.0;
 /// INTERPRETATION (beyond the thesis): 2 cm, about the 1.5 cm the feet and the body centre of
 /// mass move apart when the body pitches by 2° at the 0.41 m body height, plus the foot radius.
 pub const DEFAULT_STABILITY_MARGIN_M: f64 = 0.02;
+/// Smallest normalized energy stability margin when a leg lifts (m, any number of legs).
+///
+/// INTERPRETATION (beyond the thesis): 0, static stability itself: a lift that would leave the
+/// feet in support unable to hold the body still (its centre beyond an edge of their polygon,
+/// tilted ground included) waits; any positive margin lets the thesis' rules choose as they
+/// do. A reserve against the body's sway and the estimate of its centre is the user's to add.
+pub const DEFAULT_ENERGY_MARGIN_M: f64 = 0.0;
 
 /// The default thresholds of each landing detection of a free gait.
 #[derive(Clone, Copy, Debug)]
@@ -588,9 +596,11 @@ fn free_gait<L: Leg>(g: &RawGait, c: &Ctx, heading: HeadingSpec, legs: &[L; 6], 
     };
     let stability_margin = raw.stability_margin_m.unwrap_or(DEFAULT_STABILITY_MARGIN_M);
     c.check(stability_margin.is_finite() && stability_margin >= 0.0, "gait.free.stability_margin_m", stability_margin, "a distance >= 0 m")?;
+    let energy_margin = raw.energy_margin_m.unwrap_or(DEFAULT_ENERGY_MARGIN_M);
+    c.check(energy_margin.is_finite() && energy_margin >= 0.0, "gait.free.energy_margin_m", energy_margin, "a height >= 0 m")?;
     // The elevator reflex reads the same estimator as the landing, at the same threshold.
     let elevator = raw.elevator.unwrap_or(true).then_some(threshold);
-    let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, dt, elevator };
+    let options = FreeGaitOptions { body_height: height, lift, takeoff_time, swing_time, posture_time, failed_leg, stability_margin, energy_margin, dt, elevator };
     let footholds: [Vector3<f64>; 6] = std::array::from_fn(|l| {
         let w = &workspaces[l];
         if failed_leg == Some(l) {
@@ -631,7 +641,7 @@ fn reject_periodic_fields(g: &RawGait, c: &Ctx) -> Result<()> {
     ];
     for (name, value) in written {
         if let Some(v) = value {
-            return Err(c.err(&format!("gait.{name}"), v, "not a field of pattern = \"free\"", "with the free gait: clearance_m, navigation, body_height_m, [gait.heading] and [gait.free] (takeoff_s, swing_s, posture_time_s, landing, landing_threshold_n, failed_leg, stability_margin_m)"));
+            return Err(c.err(&format!("gait.{name}"), v, "not a field of pattern = \"free\"", "with the free gait: clearance_m, navigation, body_height_m, [gait.heading] and [gait.free] (takeoff_s, swing_s, posture_time_s, landing, landing_threshold_n, failed_leg, stability_margin_m, energy_margin_m, elevator)"));
         }
     }
     Ok(())

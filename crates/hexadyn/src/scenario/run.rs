@@ -98,7 +98,7 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
         stats.observe(p, cmd, supply, pi);
         if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
             let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
-            gait_stats.observe(p.state().q.as_slice(), state, feet_down, &g.workspaces);
+            gait_stats.observe(p.state().t, p.state().q.as_slice(), state, feet_down, &g.workspaces);
         }
         last_t = meas.t;
         if recorded {

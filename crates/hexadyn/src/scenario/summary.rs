@@ -155,6 +155,10 @@ impl Summary {
             v.push((Cow::Borrowed("gait_switches"), Count(g.gait_switches)));
             v.push((Cow::Borrowed("min_feet_on_ground"), Count(g.min_feet_on_ground)));
             v.push((Cow::Borrowed("max_foot_reference_outside_workspace_m"), Number(g.max_foot_reference_outside_workspace_m)));
+            if let Some((margin, t)) = g.min_stability_margin {
+                v.push((Cow::Borrowed("min_stability_margin_m"), Number(margin)));
+                v.push((Cow::Borrowed("min_stability_margin_t_s"), Number(t)));
+            }
         }
         v
     }
@@ -187,6 +191,9 @@ pub struct GaitSummary {
     pub min_feet_on_ground: u64,
     /// Largest distance of a foot reference outside its workspace cylinder (m).
     pub max_foot_reference_outside_workspace_m: f64,
+    /// The free gait's smallest stability margin (m, the `stability_margin` column) and when
+    /// (s).
+    pub min_stability_margin: Option<(f64, f64)>,
 }
 
 impl GaitSummary {
@@ -207,6 +214,7 @@ impl GaitSummary {
             gait_switches: diagnostics.gait_switches as u64,
             min_feet_on_ground: stats.min_feet as u64,
             max_foot_reference_outside_workspace_m: stats.max_outside,
+            min_stability_margin: stats.min_stability_margin,
         }
     }
 }
@@ -348,18 +356,19 @@ pub(super) struct GaitStats {
     last: Option<([f64; 2], [f64; 2])>,
     min_feet: usize,
     max_outside: f64,
+    min_stability_margin: Option<(f64, f64)>,
 }
 
 impl Default for GaitStats {
     fn default() -> Self {
-        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0 }
+        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0, min_stability_margin: None }
     }
 }
 
 impl GaitStats {
     /// One control instant: body pose `q` (X, Y, Z, yaw, ...), the gait state, feet on the
     /// ground and the workspaces.
-    pub(super) fn observe(&mut self, q: &[f64], s: &GaitState, feet_down: usize, workspaces: &[Workspace; 6]) {
+    pub(super) fn observe(&mut self, t: f64, q: &[f64], s: &GaitState, feet_down: usize, workspaces: &[Workspace; 6]) {
         let actual = [q[0], q[1]];
         let desired = [s.pose.position.x, s.pose.position.y];
         let e = (actual[0] - desired[0]).hypot(actual[1] - desired[1]);
@@ -375,6 +384,11 @@ impl GaitStats {
         self.min_feet = self.min_feet.min(feet_down);
         for (w, f) in workspaces.iter().zip(&s.feet) {
             self.max_outside = self.max_outside.max(w.distance_outside(f));
+        }
+        if let Some(free) = &s.free {
+            if self.min_stability_margin.is_none_or(|(m, _)| free.stability_margin < m) {
+                self.min_stability_margin = Some((free.stability_margin, t));
+            }
         }
     }
 }

@@ -17,6 +17,7 @@ use crate::control::settling_time;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
 use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};
+use super::stability::energy_stability_margin;
 use super::velocity::corrected_velocities;
 use crate::control::gait::body_motion::{BodyMotion, Pose};
 use crate::control::gait::walk::{LegState, Walk};
@@ -64,6 +65,10 @@ pub struct FreeGaitOptions {
     /// Smallest static stability margin (m) that the feet left in support must keep when a leg
     /// lifts, with a failed leg (six legs follow Rules 2 and 3 alone, as in the thesis).
     pub stability_margin: f64,
+    /// Smallest normalized energy stability margin (m, [`super::stability`]) that the feet left
+    /// in support must keep when a leg lifts, on six legs and on five (beyond the thesis: its
+    /// conclusion's "stability issues in the choice of the swinging leg").
+    pub energy_margin: f64,
     /// Control period Δt (s).
     pub dt: f64,
     /// The elevator reflex of the swing ([`super::elevator`], beyond the thesis) with its
@@ -122,6 +127,10 @@ pub struct FreeGaitState {
     /// A landing foot went a lift below the ground level of the posture, or to the bottom of
     /// its leg's reach, without finding the ground: the body goes down.
     pub reaching_down: bool,
+    /// Normalized energy stability margin (m, [`super::stability`]) of the feet in support
+    /// after this update's lifts, as the controller knows them (their anchors, the estimated
+    /// body pose); −∞ with fewer than three.
+    pub stability_margin: f64,
 }
 
 /// The free gait controller of Section 7.7, for legs of any mechanism (AMRU5's pantographs by
@@ -281,9 +290,9 @@ impl<L: LegMechanism> FreeGaitController<L> {
         w.margin(&level, &Vector3::new(-v_c.x, -v_c.y, 0.0))
     }
 
-    /// The legs that lift now among the Rule 2-3 candidates: all of them with six legs; with a
-    /// failed leg, in order of increasing margin, those whose lift leaves the body centre inside
-    /// the support polygon by at least the stability margin. If that leaves the robot deadlocked
+    /// The legs that lift now among the Rule 2-3 candidates, in order of increasing margin, those
+    /// whose lift keeps the support balanced ([`Self::balanced`]). With a failed leg, if that
+    /// leaves the robot deadlocked
     /// (Section 7.7.4: a support leg at its boundary, `boundary`, that does not lift), the leg of
     /// lowest margin among those that Rule 2 alone allows and that keep the stability margin
     /// lifts instead.
@@ -303,7 +312,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
     fn lifting(&self, candidates: [bool; 6], support: &[bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
         let swaying = self.sway.map(|(b, _)| b);
         if self.options.failed_leg.is_none() {
-            return candidates;
+            return self.stable_lifts(candidates, margins, support, estimated);
         }
         let lifting = self.stable_lifts(candidates, margins, support, estimated);
         if !deadlocked(support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
@@ -366,24 +375,41 @@ impl<L: LegMechanism> FreeGaitController<L> {
         (u.norm() > 1e-3 * speed && !outwards && !leaves).then_some((blocked, u))
     }
 
-    /// Among `candidates`, in order of increasing margin, the legs whose lift leaves the body
-    /// centre inside the polygon of the feet still in support by the stability margin.
+    /// Among `candidates`, in order of increasing margin, the legs whose lift keeps the feet
+    /// still in support balanced ([`Self::balanced`]).
     fn stable_lifts(&self, candidates: [bool; 6], margins: &[f64; 6], support: &[bool; 6], estimated: &Htm) -> [bool; 6] {
         let mut order: Vec<usize> = (0..6).filter(|&l| candidates[l]).collect();
         order.sort_by(|&a, &b| margins[a].total_cmp(&margins[b]));
         let mut support = *support;
-        let centre = estimated.translation.xy();
         let mut lifting = [false; 6];
         for l in order {
             support[l] = false;
-            let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
-            if stability_margin(&centre, &feet) >= self.options.stability_margin {
+            if self.balanced(&support, estimated) {
                 lifting[l] = true;
             } else {
                 support[l] = true;
             }
         }
         lifting
+    }
+
+    /// Whether the feet `support` keep the robot balanced: the normalized energy stability
+    /// margin of their anchors at least [`FreeGaitOptions::energy_margin`] (any number of legs)
+    /// and, with a failed leg, the body centre inside their polygon by at least
+    /// [`FreeGaitOptions::stability_margin`].
+    ///
+    /// INTERPRETATION: the centre of mass is taken at the body frame's origin of the estimated
+    /// pose. The controller of Chapter 7 works from kinematics alone, without the masses, and the
+    /// body frame sits at the centre of the main body, about which the legs are mounted
+    /// symmetrically (AMRU5, the PhantomX); the legs' own shift as they swing is left out.
+    fn balanced(&self, support: &[bool; 6], estimated: &Htm) -> bool {
+        let feet: Vec<Vector3<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor).collect();
+        let centre = estimated.translation;
+        let horizontal = || {
+            let feet: Vec<Vector2<f64>> = feet.iter().map(|f| f.xy()).collect();
+            stability_margin(&centre.xy(), &feet) >= self.options.stability_margin
+        };
+        energy_stability_margin(&centre, &feet) >= self.options.energy_margin && (self.options.failed_leg.is_none() || horizontal())
     }
 }
 
@@ -617,6 +643,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary) || swaying.is_some();
         self.sway = if self.state.deadlock { self.sway(swaying, &support, &lifting, &margins, boundary, &estimated, &desired, h.velocity.xy().norm()) } else { None };
         self.state.deadlocked_periods += usize::from(self.state.deadlock);
+        let standing: Vec<Vector3<f64>> = (0..6).filter(|&l| support[l] && !lifting[l]).map(|l| self.walk.legs[l].anchor).collect();
+        self.state.stability_margin = energy_stability_margin(&estimated.translation, &standing);
         self.state.reaching_down = reaching_down && room > REACH_ROOM;
 
         // The posture as the controller knows it.

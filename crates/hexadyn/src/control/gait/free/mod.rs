@@ -9,6 +9,7 @@ pub mod elevator;
 pub mod landing;
 pub mod posture;
 pub mod rules;
+pub mod stability;
 pub mod velocity;
 
 pub use controller::{FreeGaitController, FreeGaitOptions, FreeGaitState};
