@@ -305,6 +305,10 @@ fn free_gait_climbs_the_8_cm_step() {
     assert!((rise - 0.04).abs() < 0.015, "the body rose by {rise} m on the step");
     assert!(end.abs() < 0.01, "the body height changed by {end} m at the end");
     assert!(g.tracking_error_xy_final_m < 0.02, "{}", g.tracking_error_xy_final_m);
+    // The takeoffs from the step keep the feet inside their reach (issue 37: 1712 references
+    // clamped by Eq. 7.7 and 546 limit-switch cuts when the takeoff rose by the lift wherever
+    // the foot was).
+    assert_eq!((g.clamped_ik_references, r.summary.limit_switch_cuts), (0, 0));
 }
 
 /// Section 7.7.5, case 3: the spline over the rough ground with and without navigation,

@@ -210,6 +210,32 @@ impl<L: LegMechanism> FreeGaitController<L> {
         self.legs_kinematics[leg].inverse(p, q).is_ok_and(|ik| ik.is_reached())
     }
 
+    /// The foot reference `p` (leg frame) of a foot in the air, lowered when it is beyond the
+    /// leg's reach to the highest point the leg reaches above its horizontal position less the
+    /// room of [`REACH_ROOM`] (the security margin of the working volume, which keeps the joint
+    /// references off their end-stops), down to `floor` at most (the height of the ground it
+    /// took off from): `p` itself when the leg reaches it or reaches nothing down to `floor`.
+    /// Reached means Eq. 7.7 from the joints `q` (the last references) reaches it, the test
+    /// that counts the clamped references.
+    ///
+    /// Beyond the thesis, whose takeoff rises by the lift wherever the foot is: after a step up
+    /// the foot on the step starts its takeoff high in its leg frame, and the lift took legs 1
+    /// and 5 of `free_gait_step` against their top end-stop (546 limit-switch cuts, 1712
+    /// references clamped by Eq. 7.7; issue 37). The periodic gaits keep their references
+    /// inside the workspace; the free gait keeps them inside the reach.
+    fn within_reach(&self, leg: usize, p: Vector3<f64>, floor: f64, q: &Vector3<f64>) -> Vector3<f64> {
+        let at = |z: f64| Vector3::new(p.x, p.y, z);
+        if self.reaches(leg, &p, q) || !(floor < p.z) || !self.reaches(leg, &at(floor), q) {
+            return p;
+        }
+        let (mut low, mut high) = (floor, p.z);
+        while high - low > 1e-6 {
+            let mid = 0.5 * (low + high);
+            if self.reaches(leg, &at(mid), q) { low = mid } else { high = mid }
+        }
+        at((low - REACH_ROOM).max(floor))
+    }
+
     fn working(&self, leg: usize) -> bool {
         self.options.failed_leg != Some(leg)
     }
@@ -542,8 +568,9 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                     FootPhase::Support => frame_desired.inverse().apply(&leg.anchor),
                     // Lifted at constant speed with the support's horizontal motion.
                     FootPhase::Takeoff => {
-                        let mut p = frame_desired.inverse().apply(&leg.anchor);
-                        p.z += landing_speed * leg.elapsed.min(o.takeoff_time);
+                        let ground = frame_desired.inverse().apply(&leg.anchor);
+                        let lifted = ground + Vector3::z() * (landing_speed * leg.elapsed.min(o.takeoff_time));
+                        let p = self.within_reach(l, lifted, ground.z, &leg.joints);
                         if leg.elapsed >= o.takeoff_time - 0.5 * o.dt {
                             (leg.phase, leg.elapsed, leg.pep, leg.swing_time) = (FootPhase::Swing, 0.0, p, o.swing_time);
                         }
@@ -585,6 +612,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                             let v = (aep - leg.pep) / leg.swing_time;
                             let mut p = leg.foot + Vector3::new(v.x, v.y, 0.0) * o.dt;
                             p.z = leg.pep.z;
+                            let p = self.within_reach(l, p, frame_desired.inverse().apply(&leg.anchor).z, &leg.joints);
                             if leg.elapsed >= leg.swing_time - 0.5 * o.dt {
                                 // The landing: a virtual anchor where the foot is, so that the
                                 // support algorithm runs while the foot descends (Section 7.6).
