@@ -88,16 +88,16 @@ def simulate(
         scenario: a scenario file, or the name of a shipped scenario (see :func:`list_scenarios`).
         out: if given, the results are saved to this folder (atomically, with the power tables,
             see :func:`hexadyn.report.save`); it must not exist unless ``overwrite`` is true.
+        progress: True for a tqdm progress bar over the simulated time (on stderr), False for
+            none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
         save: without `out`, save the results to ``results/<scenario name>`` (relative to the
             working directory), or ``results/<scenario name>-2``, ``-3``... if it exists, as
             ``hexadyn simulate`` does (:func:`free_results_folder`); ``results.path`` tells which.
-        progress: True for a tqdm progress bar over the simulated time (on stderr), False for
-            none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
         overwrite: replace an existing ``out`` folder.
         overrides: scenario fields set from outside the file, by dotted name, e.g.
             ``{"model.friction": "dry_viscous", "gait.heading.vx_m_s": 0.01}`` (values: bool,
-            int, float, str, lists and dicts of those). The results' metadata then holds the
-            effective scenario text.
+            int, float, str, lists and dicts of those), what :meth:`hexadyn.Scenario.overrides`
+            gives. The results' metadata then holds the effective scenario text.
         plots, legs, formats: with `out`, the figures of :func:`hexadyn.report.plot` in
             ``out/plots`` (skipped for a series too long for memory).
 
