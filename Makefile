@@ -1,4 +1,4 @@
-# Developer and CI commands. `make run` and `make test` work on a fresh machine with Python >= 3.10
+# Developer and CI commands. `make run` and `make test` work on a fresh machine with Python >= 3.11
 # and a Rust toolchain: they create .venv, install the pinned dependencies and build the engine.
 
 SHELL := /bin/bash

@@ -124,19 +124,18 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
     failed checks are printed and listed under `warnings` in summary.json. Ctrl-C stops the run
     and writes nothing (exit status 130).
     """
-    from hexadyn import _core, report
+    from hexadyn import report
 
     path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
-    # Validate before anything is created: a bad scenario leaves no results folder behind.
-    info = _core.load_scenario(str(path))
-    if out is None:
-        out = free_results_folder(info["name"])
-    elif out.exists() and not overwrite:
+    if out is not None and out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
-    results = hexadyn.simulate(path, out, progress=not no_progress, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
+    # Without --out: results/<scenario name>, numbered. The scenario is validated before
+    # anything is created: a bad scenario leaves no results folder behind.
+    results = hexadyn.simulate(path, out, progress=not no_progress, save=True, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
+    out = results.path
     s = results.summary
     click.echo(f"Results: {out}")
-    click.echo(f"  scenario    {info['name']} ({path})")
+    click.echo(f"  scenario    {s['scenario']} ({path})")
     click.echo(f"  simulated   {s['duration_s']:.3f} s in {s['wall_time_s']:.2f} s wall time, {s['integration_steps']} steps ({s['rejected_steps']} rejected)")
     click.echo(f"  series      {results.shape[0]} instants x {results.shape[1]} columns")
     click.echo(f"  body height {s['body_height_change_m'] * 1e3:+.4f} mm over the run")
@@ -297,7 +296,7 @@ def scenarios() -> None:
     """List the shipped scenarios (run one with `hexadyn simulate NAME`)."""
     from hexadyn import _core
 
-    files = hexadyn.list_scenarios()
+    files = hexadyn.scenario_files()
     click.echo(f"Shipped scenarios ({hexadyn.SCENARIOS_DIR}):")
     width = max((len(p.stem) for p in files), default=0)
     for p in files:

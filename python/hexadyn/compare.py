@@ -196,7 +196,7 @@ def _scenario_velocity(path: Path) -> float | None:
     return None if gait is None else gait["vx_m_s"]
 
 
-def _progress_bar(progress: bool | Callable[[int, int], object], total: int) -> Callable[[int | None], None]:
+def _progress_bar(progress: bool | Callable[[int, int], object], total: int) -> Callable[[int | None], object]:
     """A callback taking the number of finished runs (None when finished)."""
     if callable(progress):
         return lambda n: None if n is None else progress(n, total)

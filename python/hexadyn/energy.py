@@ -153,7 +153,7 @@ def averaged_power(results: Results) -> pd.DataFrame:
     for name, codes in groups.items():
         rows = {}
         for leg in LEGS:
-            mask = slice(None) if codes is None else phases[leg].isin(codes).to_numpy()
+            mask = slice(None) if codes is None or phases is None else phases[leg].isin(codes).to_numpy()
             rows[leg] = [p[actuator(j, leg)].to_numpy()[mask].sum() * dt / duration for j in joints]
         block = pd.DataFrame.from_dict(rows, orient="index", columns=list(joints))
         block.loc[TOTAL] = block.sum()

@@ -25,7 +25,7 @@ The thresholds are stated with their reasons next to them; every shipped scenari
 from __future__ import annotations
 
 import math
-from typing import Any, Mapping
+from typing import Any, Mapping, TypeGuard
 
 __all__ = ["check", "MAX_BALANCE_ERROR", "MAX_BODY_DROP", "MAX_DISTANCE_FRACTION", "MAX_PENETRATION_RATIO", "MAX_TRACKING_FRACTION", "TRACKING_ALLOWANCE_M"]
 
@@ -103,5 +103,6 @@ def check(summary: Mapping[str, Any]) -> list[str]:
     return warnings
 
 
-def _finite(x: Any) -> bool:
+def _finite(x: object) -> TypeGuard[float]:
+    """A finite number (not a boolean)."""
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)

@@ -26,18 +26,22 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Mapping, Sequence
 
 import matplotlib
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
+from matplotlib.rcsetup import cycler
 
 from hexadyn import energy, ground_detection
 from hexadyn.vocabulary import FAILED, LANDING, REVOLUTE, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.typing import RcKeyType
+
     from hexadyn.results import Results
 
 #: Legs of the per-actuator figures by default: legs 0 and 2, as in Section 6.4.
@@ -49,7 +53,7 @@ FORMATS = ("png", "pdf", "svg")
 DPI = 300
 
 #: One style for every figure (paper quality: small serif-free fonts, light grid).
-STYLE = {
+STYLE: dict[RcKeyType, Any] = {
     "font.size": 8,
     "axes.titlesize": 9,
     "axes.labelsize": 8,
@@ -60,7 +64,7 @@ STYLE = {
     "grid.alpha": 0.3,
     "grid.linewidth": 0.5,
     "lines.linewidth": 0.9,
-    "axes.prop_cycle": matplotlib.cycler(color=["#1f4e79", "#c0392b", "#2e8b57", "#e67e22", "#7d3c98", "#7f8c8d"]),
+    "axes.prop_cycle": cycler(color=["#1f4e79", "#c0392b", "#2e8b57", "#e67e22", "#7d3c98", "#7f8c8d"]),
     "figure.constrained_layout.use": True,
     "savefig.dpi": DPI,
     "pdf.fonttype": 42,
@@ -244,9 +248,9 @@ def trajectory_figure(results: Results) -> Figure:
     """The body path in the ground plane (X, Y) with its reference and the footholds (equal
     axes), and below it the XY tracking error over time."""
     ts = results.timeseries
-    if not {"X_ref", "Y_ref"} <= set(ts.columns):
-        raise ValueError("trajectory: these results have no body reference X_ref, Y_ref (not a walking scenario)")
     phases = energy.foot_phases(results)
+    if not {"X_ref", "Y_ref"} <= set(ts.columns) or phases is None:
+        raise ValueError("trajectory: these results have no body reference X_ref, Y_ref (not a walking scenario)")
     t = ts.index.to_numpy()
     with style():
         fig = Figure(figsize=(6.3, 4.4))
@@ -358,7 +362,7 @@ def _per_actuator(block: pd.DataFrame) -> pd.Series:
     return pd.Series({actuator(j, leg): block.loc[leg, j] for leg in LEGS for j in joints})
 
 
-def _stacked_actuator_bars(ax, parts: pd.DataFrame, colours: Mapping[str, str], labels: Mapping[str, str]) -> np.ndarray:
+def _stacked_actuator_bars(ax: Axes, parts: pd.DataFrame, colours: Mapping[str, str], labels: Mapping[str, str]) -> np.ndarray:
     """Bars of the 18 actuators (the index of `parts`, leg by leg) grouped by leg, the columns of
     `parts` stacked (positive parts upwards from zero, negative ones downwards); returns the bar
     positions."""

@@ -259,8 +259,8 @@ class SeriesWriter:
         self.path = path
         self.units = dict(units or {})
         self.rows = 0
-        self._writer = None
-        self._schema = None
+        self._writer: Any = None  # pyarrow.parquet.ParquetWriter once opened
+        self._schema: Any = None  # pyarrow.Schema once opened
         self._pending: list[list[Any]] = []  # chunks not written yet: one list of arrays per chunk, in schema order
         self._pending_rows = 0
         self._group_rows = 1  # rows of a row group, from the number of columns (:meth:`_open`)
@@ -336,7 +336,7 @@ def _read_row(file: Any, group: int, index: int) -> Any:
     names = file.schema_arrow.names
     rows = file.metadata.row_group(group).num_rows
     step = max(1, ROW_READ_BYTES // (8 * rows))
-    row = {}
+    row: dict[str, list[Any]] = {}
     for k in range(0, len(names), step):
         block = file.read_row_group(group, columns=names[k : k + step], use_threads=False)
         row.update((name, [block.column(name)[index % rows].as_py()]) for name in block.column_names)  # copies: a slice would keep the block

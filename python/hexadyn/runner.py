@@ -28,10 +28,16 @@ CHUNK_ROWS = 2_000
 #: ``progress(t_s, duration_s)``.
 Progress = Union[bool, Callable[[float, float], object]]
 
-__all__ = ["SCENARIOS_DIR", "list_scenarios", "resolve_scenario", "safe_folder_name", "simulate"]
+__all__ = ["SCENARIOS_DIR", "free_results_folder", "list_scenarios", "resolve_scenario", "safe_folder_name", "scenario_files", "simulate"]
 
 
-def list_scenarios() -> list[Path]:
+def list_scenarios() -> list[str]:
+    """The names of the shipped scenarios, sorted (what ``hexadyn scenarios`` lists and
+    :func:`simulate` takes)."""
+    return [p.stem for p in scenario_files()]
+
+
+def scenario_files() -> list[Path]:
     """The shipped scenario files, sorted by name."""
     return sorted(SCENARIOS_DIR.glob("*.toml"))
 
@@ -51,7 +57,7 @@ def resolve_scenario(scenario: str | os.PathLike) -> Path:
         shipped = SCENARIOS_DIR / f"{stem}.toml"
         if shipped.is_file():
             return shipped
-    names = ", ".join(p.stem for p in list_scenarios())
+    names = ", ".join(list_scenarios())
     raise FileNotFoundError(errno.ENOENT, f"no such scenario file, nor a shipped scenario ({names})", text)
 
 
@@ -60,6 +66,7 @@ def simulate(
     out: str | os.PathLike | None = None,
     progress: Progress = True,
     *,
+    save: bool = False,
     overwrite: bool = False,
     overrides: Mapping[str, Any] | None = None,
     plots: bool = False,
@@ -70,8 +77,8 @@ def simulate(
     holds the key figures of the power analysis (:func:`hexadyn.energy.add_energy_figures`) and
     the failed health checks of the run (``warnings``, :func:`hexadyn.health.check`).
 
-    Without `out` the time series is kept in memory; a run whose series would exceed
-    :data:`IN_MEMORY_LIMIT_BYTES` is refused before it starts (give `out`). With `out` the
+    Without `out` (nor `save`) the time series is kept in memory; a run whose series would
+    exceed :data:`IN_MEMORY_LIMIT_BYTES` is refused before it starts (give `out`). With `out` the
     series is streamed to ``timeseries.parquet`` in the results folder as the run goes (memory
     bounded by a constant whatever the duration), the folder is written atomically
     (:func:`hexadyn.report.save`) and ``results.timeseries`` is read from it on first access; a
@@ -83,11 +90,14 @@ def simulate(
             see :func:`hexadyn.report.save`); it must not exist unless ``overwrite`` is true.
         progress: True for a tqdm progress bar over the simulated time (on stderr), False for
             none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
+        save: without `out`, save the results to ``results/<scenario name>`` (relative to the
+            working directory), or ``results/<scenario name>-2``, ``-3``... if it exists, as
+            ``hexadyn simulate`` does (:func:`free_results_folder`); ``results.path`` tells which.
         overwrite: replace an existing ``out`` folder.
         overrides: scenario fields set from outside the file, by dotted name, e.g.
             ``{"model.friction": "dry_viscous", "gait.heading.vx_m_s": 0.01}`` (values: bool,
-            int, float, str, lists and dicts of those). The results' metadata then holds the
-            effective scenario text.
+            int, float, str, lists and dicts of those), what :meth:`hexadyn.Scenario.overrides`
+            gives. The results' metadata then holds the effective scenario text.
         plots, legs, formats: with `out`, the figures of :func:`hexadyn.report.plot` in
             ``out/plots`` (skipped for a series too long for memory).
 
@@ -104,6 +114,8 @@ def simulate(
         atomic.refuse_existing(out, "results folder")
     overrides = dict(overrides) if overrides else None
     info = _core.load_scenario(os.fspath(path), overrides)  # invalid: nothing is created
+    if out is None and save:
+        out = free_results_folder(info["name"])
     rows = round(info["duration_s"] / info["period_s"]) + 1
 
     def finish(results: Results) -> Results:
@@ -119,7 +131,7 @@ def simulate(
                 _refuse_beyond(rows, len(columns), IN_MEMORY_LIMIT_BYTES, "memory", "pass out= to stream the series to a results folder")
             chunks.append(columns)
 
-        raw = _run(_core, path, info, overrides, progress, keep)
+        raw = _run(path, info, overrides, progress, keep)
         import numpy as np
         import pandas as pd
 
@@ -136,7 +148,7 @@ def simulate(
                     writer.units = dict(units)
                 writer.write_columns(columns)
 
-            raw = _run(_core, path, info, overrides, progress, write)
+            raw = _run(path, info, overrides, progress, write)
         results = Results.from_engine(raw, scenario_path=path)
         results.path = tmp
         return finish(results)
@@ -159,10 +171,12 @@ def _size(n: float) -> str:
     raise AssertionError("unreachable")
 
 
-def _run(core, path: Path, info: Mapping[str, Any], overrides: dict | None, progress: Progress, chunk: Callable[[Mapping[str, Any], Mapping[str, str]], None]) -> dict:
+def _run(path: Path, info: Mapping[str, Any], overrides: dict[str, Any] | None, progress: Progress, chunk: Callable[[Mapping[str, Any], Mapping[str, str]], None]) -> dict[str, Any]:
     """The engine's run, the series handed to `chunk` as it goes."""
+    from hexadyn import _core
+
     if progress is not True:
-        return core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides, chunk=chunk, chunk_rows=CHUNK_ROWS)
+        return _core.run_scenario(os.fspath(path), progress if callable(progress) else None, overrides, chunk=chunk, chunk_rows=CHUNK_ROWS)
     from tqdm.auto import tqdm
 
     duration = float(info["duration_s"])
@@ -171,7 +185,7 @@ def _run(core, path: Path, info: Mapping[str, Any], overrides: dict | None, prog
         def update(t: float, _duration: float) -> None:
             bar.update(min(t, duration) - bar.n)
 
-        raw = core.run_scenario(os.fspath(path), update, overrides, chunk=chunk, chunk_rows=CHUNK_ROWS)
+        raw = _core.run_scenario(os.fspath(path), update, overrides, chunk=chunk, chunk_rows=CHUNK_ROWS)
         bar.update(duration - bar.n)  # the last instant is duration up to rounding
     return raw
 

@@ -66,7 +66,8 @@ class _WithMetadata(Protocol):
     """What :meth:`Joints.of` reads: results (:class:`hexadyn.results.Results`) with their
     ``metadata``, which holds the robot description text."""
 
-    metadata: Mapping[str, Any]
+    @property
+    def metadata(self) -> Mapping[str, Any]: ...
 
 
 @dataclass(frozen=True)

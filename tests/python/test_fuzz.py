@@ -17,7 +17,7 @@ import hexadyn
 from hexadyn import _core, health
 
 ROOT = Path(__file__).resolve().parents[2]
-SCENARIOS = {p.name: p.read_bytes() for p in hexadyn.list_scenarios()}
+SCENARIOS = {p.name: p.read_bytes() for p in hexadyn.scenario_files()}
 ROBOT = (ROOT / "robots" / "amru5.toml").read_bytes()
 #: The scenario that names the mutated robot file.
 ROBOT_USER = b'[scenario]\nname = "robot_fuzz"\nduration_s = 1.0\nrobot = "robot.toml"\n[control]\nmode = "pi"\n'

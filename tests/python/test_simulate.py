@@ -35,9 +35,10 @@ def sine(sine_file) -> Results:
 
 
 def test_shipped_scenarios_are_listed_and_valid():
-    files = hexadyn.list_scenarios()
+    files = hexadyn.scenario_files()
     # The scenarios found are those of the repository (where the Rust tests look), and there are some.
     assert [p.name for p in files] == sorted(p.name for p in SOURCE_SCENARIOS.glob("*.toml"))
+    assert hexadyn.list_scenarios() == [p.stem for p in files]
     assert len(files) >= 30 and DEFAULT_SCENARIO in {p.stem for p in files}
     for p in files:
         # Shipped as package data, next to the Python modules.
@@ -236,7 +237,7 @@ def test_walking_scenario(tmp_path: Path):
     assert set(df["phase[1]"].unique()) == {0.0, 1.0, 2.0}
     assert (df["phase[0]"] == 0).all()
     s = r.summary
-    assert s["control"] == "gait" and s["gait_pattern"] == "tripod" and s["navigation"] == "false"
+    assert s["control"] == "gait" and s["gait_pattern"] == "tripod" and s["navigation"] is False
     assert s["tracking_error_xy_max_m"] < 2e-3
     assert s["reference_distance_m"] == pytest.approx(0.015 * 1.995, abs=1e-6)
     assert s["gait_switches"] == 0 and s["clamped_ik_references"] == 0 and s["min_feet_on_ground"] == 3
@@ -324,8 +325,8 @@ def test_engine_errors_are_value_errors(tmp_path: Path):
 def test_cli_scenarios():
     result = CliRunner().invoke(cli, ["scenarios"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
-    for p in hexadyn.list_scenarios():
-        assert p.stem in result.output
+    for name in hexadyn.list_scenarios():
+        assert f"  {name} " in result.output
     assert "(default)" in result.output
 
 

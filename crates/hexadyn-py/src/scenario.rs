@@ -72,7 +72,8 @@ fn toml_value(field: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
 }
 
 /// Reads and validates a scenario file without running it. Returns a dict with "name",
-/// "description", "duration_s", "period_s" (the control period), "friction", "model" (a dict: "friction", "load_dependence",
+/// "description", "text" (the scenario TOML text that would run: the file's, or with overrides
+/// the effective text, comments dropped and the overrides listed in a header), "duration_s", "period_s" (the control period), "friction", "model" (a dict: "friction", "load_dependence",
 /// "inductance"), "control", "robot" (`"amru5"` or the robot file), "lifted_legs", "motions"
 /// (their count) and "gait" (None, or in gait mode a dict with "pattern", "period_s",
 /// "duty_factor", "cycle", "heading", "vx_m_s" (the forward velocity of a constant heading,
@@ -86,6 +87,7 @@ pub fn load_scenario<'py>(py: Python<'py>, path: PathBuf, overrides: Option<Boun
     let d = PyDict::new(py);
     d.set_item("name", &s.name)?;
     d.set_item("description", &s.description)?;
+    d.set_item("text", &s.text)?;
     d.set_item("duration_s", s.duration)?;
     d.set_item("period_s", s.period())?;
     d.set_item("friction", s.model.friction.name())?;
@@ -258,6 +260,7 @@ pub(crate) fn entries_dict<'py>(py: Python<'py>, entries: Vec<(Cow<'static, str>
             SummaryValue::Text(s) => d.set_item(name, s)?,
             SummaryValue::Count(n) => d.set_item(name, n)?,
             SummaryValue::Number(x) => d.set_item(name, x)?,
+            SummaryValue::Flag(b) => d.set_item(name, b)?,
         }
     }
     Ok(d)

@@ -21,6 +21,7 @@ fn main() {
             SummaryValue::Text(s) => println!("{name:<32} {s}"),
             SummaryValue::Count(n) => println!("{name:<32} {n}"),
             SummaryValue::Number(x) => println!("{name:<32} {x:.6e}"),
+            SummaryValue::Flag(b) => println!("{name:<32} {b}"),
         }
     }
     // Optional columns: printed every 10 % of the run.

@@ -325,7 +325,7 @@ impl Row {
     }
 
     fn summary(&self, s: &Scenario, stats: &LinkStats, controller_time: &[f64], stop: Option<&SafetyStop>, wall: f64) -> Vec<(Cow<'static, str>, SummaryValue)> {
-        use SummaryValue::{Count, Number, Text};
+        use SummaryValue::{Count, Flag, Number, Text};
         let rows = self.rec.rows() as u64;
         // Rows of missed periods included: one row per period.
         let duration = self.last_t.unwrap_or(0.0);
@@ -342,7 +342,7 @@ impl Row {
             ("control_periods", Count(rows.saturating_sub(1))),
             ("rows", Count(rows)),
             ("safety_stop", Text(stop.map_or_else(|| "none".to_string(), ToString::to_string))),
-            ("realtime", Text(stats.realtime.to_string())),
+            ("realtime", Flag(stats.realtime)),
             ("broadcasts", Count(stats.broadcasts)),
             ("missed_periods", Count(stats.missed_periods)),
             ("lateness_p50_s", Number(lateness.p50)),

@@ -12,12 +12,14 @@ use crate::control::Command;
 use crate::hexapod::{LegJoints, Workspace, JOINTS};
 use crate::robot::simulation::SimulatedRobot;
 
-/// One summary value.
+/// One summary value, typed as it is written to `summary.json`: a string, an integer, a float
+/// or a boolean.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SummaryValue {
     Text(String),
     Count(u64),
     Number(f64),
+    Flag(bool),
 }
 
 /// Totals and diagnostics of a run. Energies in J, lengths in m, times in s.
@@ -93,7 +95,7 @@ impl Summary {
     /// The values in a fixed order, names with units as suffixes; the per-joint entries carry
     /// the robot's joint names (`energy_electrical_q_v_j`, `max_tracking_error_q_v_m` on AMRU5).
     pub fn entries(&self) -> Vec<(Cow<'static, str>, SummaryValue)> {
-        use SummaryValue::{Count, Number, Text};
+        use SummaryValue::{Count, Flag, Number, Text};
         let mut v: Vec<(Cow<'static, str>, SummaryValue)> = vec![
             ("scenario", Text(self.scenario.clone())),
             ("friction", Text(self.friction.to_string())),
@@ -144,7 +146,7 @@ impl Summary {
             v.push((Cow::Borrowed("gait_pattern"), Text(g.pattern.clone())));
             v.push((Cow::Borrowed("gait_cycle"), Text(g.cycle.to_string())));
             v.push((Cow::Borrowed("gait_heading"), Text(g.heading.to_string())));
-            v.push((Cow::Borrowed("navigation"), Text(g.navigation.to_string())));
+            v.push((Cow::Borrowed("navigation"), Flag(g.navigation)));
             v.push((Cow::Borrowed("tracking_error_xy_max_m"), Number(g.tracking_error_xy_max_m)));
             v.push((Cow::Borrowed("tracking_error_xy_final_m"), Number(g.tracking_error_xy_final_m)));
             v.push((Cow::Borrowed("tracking_error_yaw_max_rad"), Number(g.tracking_error_yaw_max_rad)));
