@@ -10,7 +10,9 @@ their confidence intervals; :func:`hexadyn.identify.output.save` writes the tabl
 statistics of the Monte Carlo runs. ``hexadyn identify`` is the command line
 (docs/identification.md).
 
-Modules: ``logs`` (reading and checking), ``sensors`` (the current sensor chain of Section
+Modules: ``logs`` (reading), ``checks`` (what a log and a fit must be to be identified
+honestly: numbers, a constant time step, every leg of a campaign, physical magnitudes, the
+friction's sign), ``sensors`` (the current sensor chain of Section
 5.6.2 and the encoders, for preprocessing and test logs), ``sections`` (constant-velocity
 sections), ``torques`` (friction torque from current and leg model), ``fit`` (least squares
 and confidence intervals), ``steady`` (Eq. 5.3-5.4, 5.12), ``breakaway`` (Eq. 5.10-5.11),
