@@ -199,7 +199,7 @@ class Campaign:
         ``variant``, ``velocity_m_s``, ``run_index`` and ``error``, in run order."""
         with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
             runs = store.runs()
-        return runs.loc[runs["status"] == "failed", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
+        return runs.loc[runs["status"] != "ok", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
 
     def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
         from tqdm.auto import tqdm
