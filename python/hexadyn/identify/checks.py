@@ -1,6 +1,6 @@
 """What a log must be for the identification to fit it honestly, and what a fit must give.
 
-:func:`check_log` runs on every log :func:`hexadyn.identify.logs.load_log` reads and refuses,
+:func:`check_log` runs on every log :func:`hexadyn.identify.reading.load_log` reads and refuses,
 with one line naming the file, the column and row, the value and what is allowed:
 
 - a column the identification reads (time, positions, currents, voltages, foot loads) that
