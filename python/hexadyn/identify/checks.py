@@ -120,7 +120,7 @@ def _check_time(log: Log) -> None:
     steps = np.diff(t)
     if np.any(steps <= 0):
         k = int(np.flatnonzero(steps <= 0)[0])
-        raise IdentifyError(f"{log.source}: time is not strictly increasing: t[{k}] = {t[k]} s, t[{k + 1}] = {t[k + 1]} s")
+        raise IdentifyError(f"{log.source}: time is not strictly increasing: t[{k}] = {t[k]} s, t[{k + 1}] = {t[k + 1]} s; allowed: one row per sample, in time order")
     dt = float(np.median(steps))
     low, high = STEP_RANGE_S
     if not low <= dt <= high:

@@ -48,8 +48,8 @@ DEFAULT_SCENARIOS = {"amru5": DEFAULT_SCENARIO, "phantomx": "phantomx_montecarlo
 VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
 
 #: The most simulations (runs x velocities x variants) a campaign may hold: 125 times the
-#: thesis' 8000 (1000 runs, 4 velocities, 2 variants), a day and a half of walks on one core at
-#: 0.13 s each; its list of runs takes about 100 MB.
+#: thesis' 8000 (1000 runs, 4 velocities, 2 variants), four and a half days of 60 s walks on
+#: one core at 0.4 s each; its list of runs takes about 100 MB.
 MAX_SIMULATIONS = 1_000_000
 
 #: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
