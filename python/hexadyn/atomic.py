@@ -7,7 +7,8 @@ leaves an existing target untouched. The temporaries are named ``.NAME.PID.XXXXX
 while writing (``kill -9``, a power cut) cannot remove its temporary, so every write first
 removes the temporaries in its folder whose process is gone (:func:`remove_stale`). Used for
 results folders (:mod:`hexadyn.report`), the friction comparison (:mod:`hexadyn.compare`) and
-the Monte Carlo files (:mod:`hexadyn.montecarlo`).
+the Monte Carlo files (:mod:`hexadyn.montecarlo`, whose table and figures are one set of files
+in the campaign folder: :func:`write_files`).
 """
 
 from __future__ import annotations
@@ -17,9 +18,9 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
-__all__ = ["refuse_existing", "remove_stale", "write_file", "write_folder"]
+__all__ = ["refuse_existing", "remove_stale", "write_file", "write_files", "write_folder"]
 
 #: Suffixes of the temporaries of this module.
 _TEMPORARY_SUFFIXES = (".partial", ".old")
@@ -47,6 +48,25 @@ def write_file(path: Path, write: Callable[[Path], object]) -> None:
         tmp.unlink(missing_ok=True)
         raise
     _fsync_dir(path.parent)
+
+
+def write_files(folder: Path, names: Sequence[str], write: Callable[[Path], object]) -> None:
+    """Writes the files `names` of `folder` as one set: ``write(tmp)`` fills a temporary folder
+    next to them with every one of them; they are synced to disk and renamed into `folder` in
+    the order of `names`, the last one last: once it is there the others are too (readers look
+    for the last). On failure (of `write`, a missing file, Ctrl-C) the temporary folder is
+    removed and the files in `folder` are untouched."""
+    remove_stale(folder)
+    tmp = Path(tempfile.mkdtemp(prefix=_prefix(folder / names[-1]), suffix=".partial", dir=folder))
+    try:
+        write(tmp)
+        for name in names:
+            _fsync(tmp / name)
+        for name in names:
+            os.replace(tmp / name, folder / name)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    _fsync_dir(folder)
 
 
 def write_folder(target: Path, write: Callable[[Path], object]) -> None:

@@ -325,9 +325,11 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     with friction drawn per run from the Gaussians of the robot's [monte_carlo] table (AMRU5:
     Table 6.7), truncated at 3 sigma, physical signs. Rerunning the same command resumes an
     interrupted campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf
-    to --out.
+    to --out. A campaign with failed simulations (stored, not retried) ends with one line
+    naming them and exit status 1.
     """
     from hexadyn.montecarlo import DEFAULT_SCENARIOS, Campaign
+    from hexadyn.montecarlo.tables import failure_line
 
     if scenario is not None and robot is not None:
         raise click.BadParameter(f"--robot {robot} with the scenario {scenario}: the scenario names its robot; give one of them", param_hint="--robot")
@@ -356,9 +358,9 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     shown = table.rename(columns={"velocity_m_s": "V_x (m/s)", "specific_resistance_mean": "xi mean", "specific_resistance_std": "xi sigma", "specific_resistance_minus_3_sigma": "mean-3sigma", "specific_resistance_plus_3_sigma": "mean+3sigma", "average_power_w_mean": "P mean (W)"})
     click.echo(f"Specific resistance xi = E/(m g l) (Table 6.8), {campaign.scenario_name}, seed {seed}:")
     click.echo(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
-    if table["failed"].any():
-        click.echo(f"{int(table['failed'].sum())} simulations failed (kept as failed in {out}/runs.sqlite, not retried).")
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
+    if table["failed"].any():
+        raise click.ClickException(failure_line(campaign.failures(out), len(campaign.keys()), out))
 
 
 @cli.command("import-urdf")

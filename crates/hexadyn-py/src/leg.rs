@@ -42,7 +42,8 @@ impl PyLegModel {
     /// "coxa", "femur", "tibia" on the PhantomX) of `leg` the identification needs, SI joint
     /// units: `torque_per_ampere` (n k_t, Eq. 5.17), `encoder_resolution` (rad or m per count
     /// of the position sensor: a motor encoder, or a servo's own sensor), `resistance` (coil
-    /// and H-bridge, Ω), `lower` and `upper` (the joint's range), and the friction as the
+    /// and H-bridge, Ω), `nominal_voltage` (V, the robot's motors'), `lower` and `upper` (the
+    /// joint's range), and the friction as the
     /// simulation uses it with `friction = "dry_viscous"` (Eq. 6.1, the description's friction
     /// after the Section 6.1 rules): `tau_f_d_plus`, `tau_f_d_minus`, `f_v_plus`, `f_v_minus`.
     /// A pantograph robot adds `tau_f_s_plus`, `tau_f_s_minus` (Table 5.4) and, for q_h,
@@ -65,6 +66,7 @@ impl PyLegModel {
             ("torque_per_ampere", motor.k_t * motor.n),
             ("encoder_resolution", self.parts.encoders[k].resolution()),
             ("resistance", motor.r + motor.r_bridge),
+            ("nominal_voltage", self.robot.nominal_voltage()),
             ("lower", lower),
             ("upper", upper),
             ("tau_f_d_plus", law.tau_f_d_plus),

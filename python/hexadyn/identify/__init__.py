@@ -4,18 +4,20 @@ The experiments are shipped scenarios (``identification_q_r``, ``_q_v``, ``_q_h`
 campaigns of Table 5.2; ``identification_breakaway_plus``/``_minus``: Section 5.3;
 ``identification_loaded_q_h``: Section 5.4; on the PhantomX's serial legs the sawtooth campaigns
 ``phantomx_identification_coxa``, ``_femur``, ``_tibia``). :func:`identify` reads their results
-folders, or CSV logs of a real robot (:mod:`hexadyn.identify.logs`), and fits the friction parameters with
-their confidence intervals; :func:`hexadyn.identify.output.save` writes the tables of Tables
+folders, or CSV logs of a real robot (:mod:`hexadyn.identify.reading`), and fits the friction
+parameters with their confidence intervals; :func:`hexadyn.identify.output.save` writes the tables of Tables
 5.3-5.5, the figures of Fig. 5.3-5.5, the ``[model.joint_friction]`` fragment and the friction
 statistics of the Monte Carlo runs. ``hexadyn identify`` is the command line
 (docs/identification.md).
 
-Modules: ``logs`` (reading and checking), ``sensors`` (the current sensor chain of Section
-5.6.2 and the encoders, for preprocessing and test logs), ``sections`` (constant-velocity
-sections), ``torques`` (friction torque from current and leg model), ``fit`` (least squares
-and confidence intervals), ``steady`` (Eq. 5.3-5.4, 5.12), ``breakaway`` (Eq. 5.10-5.11),
-``identification`` (the whole set of logs), ``tables``, ``fragment``, ``figures``, ``output``,
-``command``.
+Modules: ``logs`` (the log and its columns), ``reading`` (results folders and CSV files),
+``checks`` (what a log and a fit must be to be identified honestly: numbers, a constant time
+step, every leg of a campaign, physical magnitudes, the friction's sign), ``sensors`` (the
+current sensor chain of Section 5.6.2 and the encoders, for preprocessing and test logs),
+``sections`` (constant-velocity sections), ``torques`` (friction torque from current and leg
+model), ``fit`` (least squares and confidence intervals), ``steady`` (Eq. 5.3-5.4, 5.12),
+``breakaway`` (Eq. 5.10-5.11), ``identification`` (the whole set of logs), ``tables``,
+``fragment``, ``figures``, ``output``, ``command``.
 """
 
 from importlib import import_module
@@ -28,7 +30,7 @@ _EXPORTS = {
     "identify": "identification",
     "IdentifyError": "logs",
     "Log": "logs",
-    "load_log": "logs",
+    "load_log": "reading",
     "SectionOptions": "sections",
 }
 

@@ -25,14 +25,22 @@ def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overw
     campaigns give the mean and standard deviation of Tables 5.3-5.5."""
     from tqdm.auto import tqdm
 
-    from hexadyn import atomic
+    from hexadyn import _core, atomic, inputs
     from hexadyn.identify import SectionOptions, identify, load_log
     from hexadyn.identify.output import save
+    from hexadyn.plots import FORMATS
 
+    figure_formats = tuple(f.strip() for f in formats.split(",") if f.strip())
+    if not figure_formats or any(f not in FORMATS for f in figure_formats):
+        raise click.BadParameter(f"{formats!r}; allowed: comma-separated formats among {', '.join(FORMATS)}", param_hint="--format")
     if out.exists() and not overwrite:
         atomic.refuse_existing(out, "identification folder")
-    robot_text = robot.read_text(encoding="utf-8") if robot else None
-    with tqdm(total=2 * len(logs), desc="identify", unit="step") as bar:
+    robot_text = None
+    if robot is not None:
+        robot_text = inputs.read_text(robot, "robot description")
+        _core.robot_properties(robot_text, str(robot))  # an invalid description is named now, by its file
+    # The bar is drawn on a terminal only and erased when done: an error stays one line.
+    with tqdm(total=2 * len(logs), desc="identify", unit="step", leave=False, disable=None) as bar:
 
         def loaded():
             for path in logs:
@@ -42,5 +50,5 @@ def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overw
                 yield log
 
         ident = identify(loaded(), joint, SectionOptions(transient_s=transient_s), progress=lambda _: bar.update())
-    folder = save(ident, out, overwrite=overwrite, formats=tuple(f.strip() for f in formats.split(",") if f.strip()))
+    folder = save(ident, out, overwrite=overwrite, formats=figure_formats)
     click.echo(f"{len(ident.fits)} dry/viscous fits, {len(ident.breakaways)} breakaways, {len(ident.load_fits)} load fits -> {folder}")

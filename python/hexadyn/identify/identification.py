@@ -9,13 +9,15 @@ deviation of these over the campaigns.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Callable, Iterable
 
 import numpy as np
 
 from hexadyn.identify.breakaway import Breakaway, BreakawayOptions, breakaway
-from hexadyn.identify.logs import LEGS, IdentifyError, Log
+from hexadyn.identify.checks import check_friction_sign
+from hexadyn.identify.logs import LEGS, UNITS, IdentifyError, Log
 from hexadyn.identify.sections import SectionOptions
 from hexadyn.identify.steady import DryViscousFit, LoadFit, SectionPoint, fit_dry_viscous, fit_load, section_points
 
@@ -101,7 +103,7 @@ def identify(
                 if kind == SAWTOOTH:
                     _sawtooth(result, log, j, leg, sections, seed)
                 elif kind == BREAKAWAY:
-                    result.breakaways.append(breakaway(log, leg, breakaway_options, j))
+                    result.breakaways.append(_breakaway(log, j, leg, breakaway_options))
                 found = found or kind is not None
         if not found:
             which = "any joint" if joint is None else f"a {joint} joint"
@@ -133,9 +135,21 @@ def _sawtooth(result: Identification, log: Log, joint: str, leg: int, options: S
         if not mine:
             raise IdentifyError(f"{log.source}: {joint}[{leg}]: no complete section in the {'plus' if direction > 0 else 'minus'} direction")
         try:
-            result.fits.append((log.source, fit_dry_viscous(mine, seed)))
+            fit = fit_dry_viscous(mine, seed)
         except ValueError as exc:
             raise IdentifyError(str(exc)) from None
+        e = fit.tau_f_d
+        sign = "+" if direction > 0 else "-"
+        check_friction_sign(f"{log.source}: {joint}[{leg}]", f"tau_f,d^{sign}", direction, e.value, e.ci_low, e.ci_high, UNITS[log.joints.kind(joint)][0])
+        result.fits.append((log.source, fit))
+
+
+def _breakaway(log: Log, joint: str, leg: int, options: BreakawayOptions) -> Breakaway:
+    b = breakaway(log, leg, options, joint)
+    if not b.reason:
+        sign = "+" if b.direction > 0 else "-"
+        check_friction_sign(f"{log.source}: {joint}[{leg}]", f"tau_f,s^{sign}", b.direction, b.tau_f_s, math.nan, math.nan, UNITS[log.joints.kind(joint)][0])
+    return b
 
 
 def _load_fits(result: Identification, seed: int) -> list[LoadFit]:

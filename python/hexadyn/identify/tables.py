@@ -14,13 +14,9 @@ import pandas as pd
 
 from hexadyn.identify.fit import Estimate
 from hexadyn.identify.identification import Identification
-from hexadyn.identify.logs import LEGS
+from hexadyn.identify.logs import LEGS, UNITS
 
 __all__ = ["mean_sigma", "table_5_3", "table_5_4", "table_5_5", "estimates", "markdown"]
-
-#: Units of the dry friction and the viscous slope per joint kind (Table 5.3: Nm, Nms for q_r).
-UNITS = {"revolute": ("Nm", "Nms"), "prismatic": ("N", "Ns/m")}
-
 
 def mean_sigma(values: list[float]) -> tuple[float, float]:
     """Eq. 5.8 and 5.9: the mean and the (n - 1) standard deviation (NaN for n < 2)."""

@@ -16,7 +16,7 @@ import os
 import signal
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any, Iterable, Iterator, Mapping, Protocol
 
 from hexadyn.montecarlo.storage import RunKey, summary_columns
@@ -25,7 +25,8 @@ __all__ = ["Executor", "ProcessPool", "Ray", "simulate_run"]
 
 Task = tuple[RunKey, Mapping[str, Any]]
 
-#: Ray: tasks submitted ahead per CPU of the cluster (one running, one queued to start at once).
+#: Tasks submitted ahead per worker process or CPU of the Ray cluster (one running, one queued
+#: to start at once): the tasks of a campaign, up to a million, are not all held at a time.
 IN_FLIGHT_PER_CPU = 2
 
 #: Ray: walks per task. Between two tasks a Ray worker waits about 3.5 ms for the next one
@@ -66,28 +67,50 @@ class Executor(Protocol):
 
     def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]: ...
 
+    def capped(self, tasks: int) -> Executor:
+        """The same executor with no more workers than `tasks` (the tasks it is given)."""
+        ...
+
 
 class ProcessPool:
     """The local cores: a ``concurrent.futures.ProcessPoolExecutor`` of ``workers`` processes
-    (default: every core). The workers ignore SIGINT: Ctrl-C reaches the parent, which stops
+    (default: every core), given :data:`IN_FLIGHT_PER_CPU` tasks per worker at a time, a new
+    one as each finishes. The workers ignore SIGINT: Ctrl-C reaches the parent, which stops
     them; a worker whose parent died (SIGKILL) exits by itself (:func:`_init_worker`)."""
 
     def __init__(self, workers: int | None = None) -> None:
-        if workers is not None and workers < 1:
-            raise ValueError(f"workers = {workers}: need at least 1 worker")
+        _check_workers(workers)
         self.workers = workers or os.cpu_count() or 1
+
+    def capped(self, tasks: int) -> ProcessPool:
+        return ProcessPool(max(1, min(self.workers, tasks)))
 
     def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
         executor = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker, initargs=(os.getpid(),))
+        queue = iter(tasks)
+        running: dict[Future, RunKey] = {}
+
+        def submit(count: int) -> None:
+            for key, overrides in itertools.islice(queue, count):
+                running[executor.submit(simulate_run, scenario, overrides)] = key
+
         try:
-            futures = {executor.submit(simulate_run, scenario, overrides): key for key, overrides in tasks}
-            for future in as_completed(futures):
-                yield futures[future], future.result()
+            submit(IN_FLIGHT_PER_CPU * self.workers)
+            while running:
+                done, _ = wait(running, return_when=FIRST_COMPLETED)
+                for future in done:
+                    submit(1)
+                    yield running.pop(future), future.result()
         except BaseException:
             executor.shutdown(wait=False, cancel_futures=True)
             _terminate_workers(executor)
             raise
         executor.shutdown()
+
+
+def _check_workers(workers: int | None) -> None:
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError(f"workers = {workers!r}: need an integer >= 1 (at most the runs left are started)")
 
 
 def _init_worker(parent: int) -> None:
@@ -120,10 +143,15 @@ class Ray:
     by the user) is used as it is and left running."""
 
     def __init__(self, address: str, workers: int | None = None) -> None:
-        if workers is not None and workers < 1:
-            raise ValueError(f"workers = {workers}: need at least 1 worker")
+        _check_workers(workers)
         self.address = address
         self.workers = workers
+
+    def capped(self, tasks: int) -> Ray:
+        """A local Ray instance gets no more CPUs than tasks; a cluster is used as it is."""
+        if self.address != "local":
+            return self
+        return Ray(self.address, max(1, min(self.workers or os.cpu_count() or 1, tasks)))
 
     def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
         try:

@@ -8,8 +8,10 @@ run: an interrupted campaign loses at most the runs that were still being simula
 primary key forbids duplicates. Failed simulations are stored too (status ``failed`` and the
 error message), so a resumed campaign does not retry them.
 
-``campaign.json`` and the output files (tables, plots) are written atomically
-(:func:`hexadyn.atomic.write_file`).
+``campaign.json`` is written atomically (:func:`hexadyn.atomic.write_file`), the output files
+(table and figures) as one set (:func:`hexadyn.montecarlo.tables.write_results`). A
+``runs.sqlite`` that SQLite cannot read (truncated, not a database, another table) is refused
+with one line naming it.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 import json
 import os
 import sqlite3
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Mapping, NamedTuple, Sequence
 
@@ -116,8 +119,12 @@ class CampaignStore:
             text = json.dumps({"format": FORMAT, "configuration": dict(configuration)}, indent=2) + "\n"
             atomic.write_file(config_file, lambda tmp: tmp.write_text(text))
         connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
-        with connection:
-            connection.execute(_schema(summary_columns(joints)))
+        try:
+            with _readable(folder / DATABASE_FILE), connection:
+                connection.execute(_schema(summary_columns(joints)))
+        except BaseException:
+            connection.close()
+            raise
         return cls(folder, connection, joints)
 
     def close(self) -> None:
@@ -131,8 +138,9 @@ class CampaignStore:
 
     def finished(self) -> set[RunKey]:
         """The runs stored so far (succeeded or failed)."""
-        rows = self._db.execute("SELECT variant, velocity_index, run_index FROM runs")
-        return {RunKey(*row) for row in rows}
+        with _readable(self.folder / DATABASE_FILE):
+            rows = self._db.execute("SELECT variant, velocity_index, run_index FROM runs")
+            return {RunKey(*row) for row in rows}
 
     def add(self, key: RunKey, velocity_m_s: float, parameters: Mapping[str, Any], outcome: Mapping[str, Any]) -> None:
         """Stores one finished run in its own transaction.
@@ -143,7 +151,7 @@ class CampaignStore:
         summary = outcome.get("summary", {})
         columns = ("variant", "velocity_index", "run_index", "velocity_m_s", "status", "error", "parameters", *self.columns)
         values = (*key, velocity_m_s, outcome["status"], outcome.get("error"), json.dumps(dict(parameters)), *(summary.get(c) for c in self.columns))
-        with self._db:
+        with _readable(self.folder / DATABASE_FILE), self._db:
             self._db.execute(f"INSERT INTO runs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})", values)
 
     def runs(self):
@@ -151,7 +159,23 @@ class CampaignStore:
         (the order makes aggregates independent of the order the runs finished in)."""
         import pandas as pd
 
-        return pd.read_sql_query("SELECT * FROM runs ORDER BY variant, velocity_index, run_index", self._db)
+        with _readable(self.folder / DATABASE_FILE, pd.errors.DatabaseError):
+            return pd.read_sql_query("SELECT * FROM runs ORDER BY variant, velocity_index, run_index", self._db)
+
+
+@contextmanager
+def _readable(database: Path, *wrapped: type[Exception]):
+    """Turns an error of the SQLite file `database` (truncated, not a database, another table,
+    locked beyond the timeout) into a ValueError of one line naming it; `wrapped`: the errors a
+    reader wraps SQLite's in (pandas'). A run stored twice (sqlite3.IntegrityError) is a bug,
+    not bad input: it is left as it is."""
+    try:
+        yield
+    except sqlite3.IntegrityError:
+        raise
+    except (sqlite3.DatabaseError, *wrapped) as exc:
+        cause = exc.__cause__ if isinstance(exc.__cause__, sqlite3.Error) else exc
+        raise ValueError(f"{database}: not a readable campaign database ({' '.join(str(cause).split())}); restore it, or move it away to start the campaign again") from exc
 
 
 def _check_same_configuration(config_file: Path, configuration: Mapping[str, Any]) -> None:

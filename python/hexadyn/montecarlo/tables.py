@@ -3,15 +3,17 @@ per velocity and friction variant) and Fig. 6.20 (means and +-3 sigma intervals 
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from hexadyn import atomic
+from hexadyn.montecarlo.storage import DATABASE_FILE
 
 if TYPE_CHECKING:  # pandas is imported when a table is made: the Ray workers import this package, not pandas
     import pandas as pd
 
-__all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "write_table", "plot_specific_resistance"]
+__all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "failure_line", "write_results", "write_table", "plot_specific_resistance"]
 
 TABLE_FILE = "specific_resistance.csv"
 FIGURE_FILES = ("specific_resistance.png", "specific_resistance.pdf")
@@ -59,16 +61,50 @@ def specific_resistance_table(runs: pd.DataFrame, variants: tuple[str, ...]) -> 
     return pd.DataFrame(rows, columns=TABLE_COLUMNS)
 
 
+def failure_line(failed: pd.DataFrame, total: int, folder: str | os.PathLike) -> str:
+    """One line naming the failed simulations of a campaign (:meth:`Campaign.failures
+    <hexadyn.montecarlo.Campaign.failures>`) of `total`, by variant and velocity, with the first
+    error and where they are kept."""
+    groups = []
+    for (variant, velocity), runs in failed.groupby(["variant", "velocity_m_s"], sort=False):
+        indices = runs["run_index"].tolist()
+        shown = ", ".join(map(str, indices[:_SHOWN])) + (", ..." if len(indices) > _SHOWN else "")
+        groups.append(f"{variant} at V_x = {velocity:g} m/s ({len(indices)}: run {shown})")
+    more = f" and {len(groups) - _SHOWN} more" if len(groups) > _SHOWN else ""
+    first = failed.iloc[0]
+    return (
+        f"{len(failed)} of {total} simulations failed: {'; '.join(groups[:_SHOWN])}{more}; "
+        f"the first ({first['variant']}, V_x = {first['velocity_m_s']:g} m/s, run {first['run_index']}): {first['error']}; "
+        f"kept as failed in {Path(folder) / DATABASE_FILE} (not retried)"
+    )
+
+
+#: Groups and run indices a failure line names before "...".
+_SHOWN = 4
+
+
+def write_results(table: pd.DataFrame, folder: Path) -> None:
+    """Writes Table 6.8 and Fig. 6.20 into ``folder`` as one set (:func:`hexadyn.atomic.write_files`):
+    the figures, then the table: a ``specific_resistance.csv`` is never there without its
+    figures, and a failure leaves the previous set and no temporary file."""
+
+    def write(tmp: Path) -> None:
+        write_table(table, tmp)
+        plot_specific_resistance(table, tmp)
+
+    atomic.write_files(folder, (*FIGURE_FILES, TABLE_FILE), write)
+
+
 def write_table(table: pd.DataFrame, folder: Path) -> Path:
-    """Writes Table 6.8 as ``specific_resistance.csv`` (atomically)."""
+    """Writes Table 6.8 as ``folder/specific_resistance.csv``."""
     path = folder / TABLE_FILE
-    atomic.write_file(path, lambda tmp: table.to_csv(tmp, index=False, float_format="%.17g"))
+    table.to_csv(path, index=False, float_format="%.17g")
     return path
 
 
 def plot_specific_resistance(table: pd.DataFrame, folder: Path) -> list[Path]:
     """Fig. 6.20: mean ξ and its ±3σ band versus velocity, one curve per variant; written as
-    PNG (300 dpi) and PDF into ``folder`` (each atomically)."""
+    PNG (300 dpi) and PDF into ``folder``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -93,12 +129,9 @@ def plot_specific_resistance(table: pd.DataFrame, folder: Path) -> list[Path]:
         ax.grid(True, alpha=0.3)
         ax.legend()
         fig.tight_layout()
-        paths = []
-        for name in FIGURE_FILES:
-            path = folder / name
-            fmt = path.suffix[1:]
-            atomic.write_file(path, lambda tmp: fig.savefig(tmp, format=fmt, dpi=300))
-            paths.append(path)
+        paths = [folder / name for name in FIGURE_FILES]
+        for path in paths:
+            fig.savefig(path, format=path.suffix[1:], dpi=300)
     finally:
         plt.close(fig)
     return paths
