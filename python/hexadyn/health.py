@@ -16,6 +16,11 @@ catch what a reader of the figures would catch:
   distance) and the distance walked against the reference;
 - the free gait's stability margin (``min_stability_margin_m``): below zero the body's centre
   was beyond an edge of the feet in support, −∞ fewer than three feet were in support;
+- walking, joint references clamped into the joint ranges (``clamped_ik_references``) and
+  limit switches cutting a motor (``limit_switch_cuts``); in the free gait, what it should never
+  hold for long, each with when it began: a deadlock (``longest_deadlock_s``, or one still on at
+  the end), fewer than three loaded feet (``longest_support_loss_s``), a foot in takeoff or
+  swing carrying load (``longest_airborne_load_s``);
 - any non-finite figure.
 
 The thresholds are stated with their reasons next to them; every shipped scenario passes them
@@ -27,7 +32,7 @@ from __future__ import annotations
 import math
 from typing import Any, Mapping, TypeGuard
 
-__all__ = ["check", "MAX_BALANCE_ERROR", "MAX_BODY_DROP", "MAX_DISTANCE_FRACTION", "MAX_PENETRATION_RATIO", "MAX_TRACKING_FRACTION", "TRACKING_ALLOWANCE_M"]
+__all__ = ["MAX_AIRBORNE_LOAD_S", "MAX_DEADLOCK_S", "MAX_SUPPORT_LOSS_S", "check", "MAX_BALANCE_ERROR", "MAX_BODY_DROP", "MAX_DISTANCE_FRACTION", "MAX_PENETRATION_RATIO", "MAX_TRACKING_FRACTION", "TRACKING_ALLOWANCE_M"]
 
 # INTERPRETATION: the thesis checks its simulations by the energy balance (Section 6.3) without
 # a figure for the error it accepts. The shipped scenarios close the balance to below 0.5 %
@@ -56,6 +61,20 @@ MAX_TRACKING_FRACTION = 1.0
 MAX_DISTANCE_FRACTION = 0.5
 #: Tracking error and distance difference always allowed (m): about a step.
 TRACKING_ALLOWANCE_M = 0.05
+
+
+# Issue 37's criteria of a successful walk over uneven ground: never fewer than three loaded feet
+# for more than 0.2 s, no foot in takeoff or swing carrying load (the engine's
+# AIRBORNE_LOAD_SHARE of the weight, 50 N on AMRU5) for more than 0.3 s. A deadlock is
+# permanent after 20 s (four times the 5 s a leg needs for takeoff, swing and landing on AMRU5:
+# one that the legs finishing their motion clear ends well before; crates/hexadyn/src/analysis/
+# outcome.rs).
+#: Longest time with fewer than three loaded feet in a healthy walk (s).
+MAX_SUPPORT_LOSS_S = 0.2
+#: Longest time a foot in takeoff or swing may carry load (s).
+MAX_AIRBORNE_LOAD_S = 0.3
+#: Longest deadlock of a healthy free gait (s).
+MAX_DEADLOCK_S = 20.0
 
 
 # The specific resistance of a run that walks no distance, and the shares of the electrical
@@ -96,10 +115,47 @@ def check(summary: Mapping[str, Any]) -> list[str]:
         allowed = TRACKING_ALLOWANCE_M + MAX_DISTANCE_FRACTION * reference
         if _finite(walked) and abs(walked - reference) > allowed:
             warnings.append(f"the body walked {walked:.3f} m for a {reference:.3f} m reference (allowed difference {allowed:.3f} m)")
+    warnings += _walk_episodes(summary)
     if margin == -math.inf:
         warnings.append(f"fewer than three feet were in support at t = {when:.2f} s (free gait): the robot stood on no support polygon")
     elif _finite(margin) and margin < 0:
         warnings.append(f"the stability margin fell to {margin * 1e3:.1f} mm at t = {when:.2f} s (free gait): the body's centre was beyond an edge of the feet in support")
+    return warnings
+
+
+#: The free gait's episodes: summary key, longest healthy duration (s), what happened.
+_FREE_GAIT_EPISODES: tuple[tuple[str, float, str], ...] = (
+    ("deadlock", MAX_DEADLOCK_S, "the free gait was deadlocked"),
+    ("support_loss", MAX_SUPPORT_LOSS_S, "fewer than three feet carried the robot"),
+    ("airborne_load", MAX_AIRBORNE_LOAD_S, "a foot in takeoff or swing carried load"),
+)
+
+
+def _walk_episodes(summary: Mapping[str, Any]) -> list[str]:
+    """The walk's warnings of :func:`check`: its clamped references and its limit-switch cuts
+    (gait runs only: the identification campaigns drive the joints to their switches on
+    purpose) and, in the free gait, its longest episodes. The periodic gaits lose their
+    support on purpose in the thesis' own cases (Section 7.6: the plain foot cycle on soft
+    ground, `soft_ground_plain`, a foot carrying load for 1.3 s into its swing; the fixed
+    tripod on the low step and the rough ground, 0.5-0.8 s on two feet): the free gait is the
+    thesis' answer to that ground, and there such an episode is a failure."""
+    if "gait_pattern" not in summary:
+        return []
+    warnings: list[str] = []
+    for key, bound, what in _FREE_GAIT_EPISODES if summary["gait_pattern"] == "free" else ():
+        duration, start = summary.get(f"longest_{key}_s"), summary.get(f"longest_{key}_t_s")
+        if _finite(duration) and _finite(start) and duration > bound:
+            warnings.append(f"{what} for {duration:.2f} s from t = {start:.2f} s (allowed {bound:g} s)")
+    if summary.get("deadlocked_at_end") is True and not any(w.startswith("the free gait was deadlocked") for w in warnings):
+        start = summary.get("longest_deadlock_t_s")
+        warnings.append("the free gait was still deadlocked at the end" + (f" (its longest deadlock began at t = {start:.2f} s)" if _finite(start) else ""))
+    clamped, last = summary.get("clamped_ik_references"), summary.get("last_clamped_ik_reference_t_s")
+    if isinstance(clamped, int) and not isinstance(clamped, bool) and clamped > 0:
+        when = f", the last at t = {last:.2f} s" if _finite(last) else ""
+        warnings.append(f"{clamped} foot references were beyond the leg's reach and clamped into the joint ranges{when}")
+    cuts = summary.get("limit_switch_cuts")
+    if isinstance(cuts, int) and not isinstance(cuts, bool) and cuts > 0:
+        warnings.append(f"the limit switches cut a motor {cuts} times: a joint was driven into its end-stop")
     return warnings
 
 

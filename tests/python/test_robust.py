@@ -236,6 +236,39 @@ def test_health_checks_flag_meaningless_runs():
     unpowered = {**healthy, "energy_electrical_j": 0.0, "friction_share": float("nan"), "joule_share": float("nan"), "specific_resistance": float("nan")}
     assert health.check(unpowered) == []
     assert health.check({**healthy, "min_stability_margin_m": 0.003, "min_stability_margin_t_s": 1.0}) == []
+    # A walk's episodes and its clamped references and cuts, with when they happened.
+    free = {**healthy, "gait_pattern": "free", "clamped_ik_references": 0, "limit_switch_cuts": 0, "deadlocked_at_end": False}
+    assert health.check(free) == []
+    for change, words in [
+        ({"longest_deadlock_s": 25.0, "longest_deadlock_t_s": 100.0}, "deadlocked for 25.00 s from t = 100.00 s (allowed 20 s)"),
+        ({"longest_deadlock_s": 3.0, "longest_deadlock_t_s": 197.0, "deadlocked_at_end": True}, "still deadlocked at the end (its longest deadlock began at t = 197.00 s)"),
+        ({"longest_support_loss_s": 0.5, "longest_support_loss_t_s": 12.0}, "fewer than three feet carried the robot for 0.50 s from t = 12.00 s"),
+        ({"longest_airborne_load_s": 2.0, "longest_airborne_load_t_s": 3.5}, "a foot in takeoff or swing carried load for 2.00 s from t = 3.50 s"),
+        ({"clamped_ik_references": 1712, "last_clamped_ik_reference_t_s": 339.17}, "1712 foot references were beyond the leg's reach and clamped into the joint ranges, the last at t = 339.17 s"),
+        ({"limit_switch_cuts": 546}, "the limit switches cut a motor 546 times"),
+    ]:
+        warnings = health.check({**free, **change})
+        assert len(warnings) == 1 and words in warnings[0], (change, warnings)
+    # Short episodes are healthy; the periodic gaits' episodes are the thesis' own cases (Section 7.6).
+    assert health.check({**free, "longest_support_loss_s": 0.2, "longest_support_loss_t_s": 1.0, "longest_airborne_load_s": 0.3, "longest_airborne_load_t_s": 1.0}) == []
+    assert health.check({**free, "gait_pattern": "tripod", "longest_airborne_load_s": 1.34, "longest_airborne_load_t_s": 4.66}) == []
+    # The identification campaigns drive the joints to their switches on purpose.
+    assert health.check({**healthy, "limit_switch_cuts": 968}) == []
+
+
+def test_health_sees_a_five_legged_walk_halted_for_good():
+    """Issue 37: with leg 4 failed the shipped five-legged walk halts for good at about 30 s
+    (a deadlock the five-leg rules do not clear); its warnings said nothing. Now the longest
+    deadlock, its start and that it was still on at the end are in the summary, and warned."""
+    r = hexadyn.simulate("free_gait_five_legs", progress=False, overrides={"gait.free.failed_leg": 4})
+    s = r.summary
+    assert s["deadlocked_at_end"] is True and s["longest_deadlock_s"] > 100.0
+    assert s["longest_deadlock_t_s"] + s["longest_deadlock_s"] == pytest.approx(s["duration_s"], abs=0.02)
+    deadlock = r.timeseries["deadlock"].to_numpy()
+    assert deadlock[-1] == 1.0 and deadlock[r.timeseries.index.get_indexer([s["longest_deadlock_t_s"]], method="nearest")[0]] == 1.0
+    assert any(w.startswith(f"the free gait was deadlocked for {s['longest_deadlock_s']:.2f} s") for w in s["warnings"]), s["warnings"]
+    # The shipped walk (leg 5 failed) is healthy.
+    assert hexadyn.simulate("free_gait_five_legs", progress=False).summary["warnings"] == []
 
 
 def test_strict_turns_warnings_into_an_exit_status(tmp_path: Path, monkeypatch):

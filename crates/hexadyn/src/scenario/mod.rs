@@ -52,6 +52,7 @@ use crate::physics::Terrain;
 use crate::sim::SimError;
 
 mod drivers;
+mod episodes;
 mod file;
 mod gait;
 mod joint_friction;

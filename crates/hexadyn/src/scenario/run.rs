@@ -89,6 +89,7 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
     let pi = s.control.tracks_references();
     let groups = ColumnGroups { references: pi, bristles: s.model.friction == FrictionModel::LuGre };
     let supply = s.model.supply_voltage;
+    let weight = plant.robot.model.multibody.total_mass() * crate::mbs::STANDARD_GRAVITY;
     let mut rec = Recorder::default();
     let mut stats = RunStats::default();
     let mut gait_stats = GaitStats::default();
@@ -97,8 +98,8 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
         let state = gait_state.as_ref().map(|g| g.borrow());
         stats.observe(p, cmd, supply, pi);
         if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
-            let feet_down = p.robot.outputs.contact.iter().filter(|c| c.normal_force > 0.0).count();
-            gait_stats.observe(p.state().t, p.state().q.as_slice(), state, feet_down, &g.workspaces);
+            let normal: [f64; 6] = std::array::from_fn(|f| p.robot.outputs.contact[f].normal_force);
+            gait_stats.observe(p.state().t, p.state().q.as_slice(), state, &normal, weight, &g.workspaces);
         }
         last_t = meas.t;
         if recorded {

@@ -3,6 +3,7 @@
 
 use std::borrow::Cow;
 
+use super::episodes::{Episode, WalkEpisodes};
 use super::gait::GaitScenario;
 use super::Scenario;
 use crate::control::gait::controller::GaitDiagnostics;
@@ -161,6 +162,20 @@ impl Summary {
                 v.push((Cow::Borrowed("min_stability_margin_m"), Number(margin)));
                 v.push((Cow::Borrowed("min_stability_margin_t_s"), Number(t)));
             }
+            // The duration (0 when it never happened) and, when it did, its start.
+            let mut episode = |name: &'static str, e: &Episode| {
+                v.push((Cow::Owned(format!("longest_{name}_s")), Number(e.longest.map_or(0.0, |(d, _)| d))));
+                if let Some((_, t)) = e.longest {
+                    v.push((Cow::Owned(format!("longest_{name}_t_s")), Number(t)));
+                }
+            };
+            episode("deadlock", &g.episodes.deadlock);
+            episode("support_loss", &g.episodes.support_loss);
+            episode("airborne_load", &g.episodes.airborne_load);
+            v.push((Cow::Borrowed("deadlocked_at_end"), Flag(g.episodes.deadlock.ongoing())));
+            if let Some(t) = g.last_clamped_t_s {
+                v.push((Cow::Borrowed("last_clamped_ik_reference_t_s"), Number(t)));
+            }
         }
         v
     }
@@ -196,6 +211,11 @@ pub struct GaitSummary {
     /// The free gait's smallest stability margin (m, the `stability_margin` column) and when
     /// (s).
     pub min_stability_margin: Option<(f64, f64)>,
+    /// The longest deadlock (free gait), loss of support (fewer than three loaded feet) and
+    /// load on a foot in takeoff or swing ([`WalkEpisodes`]).
+    pub episodes: WalkEpisodes,
+    /// When the last foot reference was clamped (s).
+    pub last_clamped_t_s: Option<f64>,
 }
 
 impl GaitSummary {
@@ -217,6 +237,8 @@ impl GaitSummary {
             min_feet_on_ground: stats.min_feet as u64,
             max_foot_reference_outside_workspace_m: stats.max_outside,
             min_stability_margin: stats.min_stability_margin,
+            episodes: stats.episodes,
+            last_clamped_t_s: diagnostics.last_clamped_at,
         }
     }
 }
@@ -359,18 +381,21 @@ pub(super) struct GaitStats {
     min_feet: usize,
     max_outside: f64,
     min_stability_margin: Option<(f64, f64)>,
+    episodes: WalkEpisodes,
 }
 
 impl Default for GaitStats {
     fn default() -> Self {
-        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0, min_stability_margin: None }
+        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0, min_stability_margin: None, episodes: WalkEpisodes::default() }
     }
 }
 
 impl GaitStats {
-    /// One control instant: body pose `q` (X, Y, Z, yaw, ...), the gait state, feet on the
-    /// ground and the workspaces.
-    pub(super) fn observe(&mut self, t: f64, q: &[f64], s: &GaitState, feet_down: usize, workspaces: &[Workspace; 6]) {
+    /// One control instant `t`: body pose `q` (X, Y, Z, yaw, ...), the gait state, the feet's
+    /// normal forces, the robot's weight (N) and the workspaces.
+    pub(super) fn observe(&mut self, t: f64, q: &[f64], s: &GaitState, normal: &[f64; 6], weight: f64, workspaces: &[Workspace; 6]) {
+        let feet_down = normal.iter().filter(|&&f| f > 0.0).count();
+        self.episodes.observe(t, &s.phases, normal, weight, s.free.is_some_and(|f| f.deadlock));
         let actual = [q[0], q[1]];
         let desired = [s.pose.position.x, s.pose.position.y];
         let e = (actual[0] - desired[0]).hypot(actual[1] - desired[1]);
