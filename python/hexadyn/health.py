@@ -13,7 +13,9 @@ catch what a reader of the figures would catch:
   of the robot standing on three feet on that ground (``static_penetration_m``);
 - the body falling (``body_height_change_m`` against ``initial_body_height_m``);
 - walking, the XY tracking error of the body against the scale of the scenario (the reference
-  distance) and the distance walked against the reference;
+  distance) and the distance walked against the path the heading commanded
+  (``commanded_path_length_m``; the desired pose's ``reference_distance_m`` for results without
+  it);
 - the free gait's stability margin (``min_stability_margin_m``): below zero the body's centre
   was beyond an edge of the feet in support, −∞ fewer than three feet were in support;
 - walking, joint references clamped into the joint ranges (``clamped_ik_references``) and
@@ -21,6 +23,8 @@ catch what a reader of the figures would catch:
   hold for long, each with when it began: a deadlock (``longest_deadlock_s``, or one still on at
   the end), fewer than three loaded feet (``longest_support_loss_s``), a foot in takeoff or
   swing carrying load (``longest_airborne_load_s``);
+- a foot beyond the border of a terrain mesh (``foot_left_terrain_t_s``), where there is no
+  ground;
 - any non-finite figure.
 
 The thresholds are stated with their reasons next to them; every shipped scenario passes them
@@ -111,10 +115,16 @@ def check(summary: Mapping[str, Any]) -> list[str]:
         allowed = TRACKING_ALLOWANCE_M + MAX_TRACKING_FRACTION * reference
         if error > allowed:
             warnings.append(f"the body strayed {error:.3f} m from its desired path (allowed {allowed:.3f} m for a {reference:.3f} m reference): the walk did not follow its command")
-        walked = summary.get("distance_walked_m")
-        allowed = TRACKING_ALLOWANCE_M + MAX_DISTANCE_FRACTION * reference
-        if _finite(walked) and abs(walked - reference) > allowed:
-            warnings.append(f"the body walked {walked:.3f} m for a {reference:.3f} m reference (allowed difference {allowed:.3f} m)")
+        # Against the commanded heading's path where the engine gives it: the desired pose halts
+        # while the free gait is deadlocked, and a walk halted for good matched it.
+        walked, commanded = summary.get("distance_walked_m"), summary.get("commanded_path_length_m")
+        target, what = (commanded, "commanded") if _finite(commanded) else (reference, "reference")
+        allowed = TRACKING_ALLOWANCE_M + MAX_DISTANCE_FRACTION * target
+        if _finite(walked) and abs(walked - target) > allowed:
+            warnings.append(f"the body walked {walked:.3f} m for a {target:.3f} m {what} path (allowed difference {allowed:.3f} m)")
+    left, foot = summary.get("foot_left_terrain_t_s"), summary.get("foot_left_terrain")
+    if _finite(left):
+        warnings.append(f"foot {foot} went beyond the border of the terrain mesh at t = {left:.2f} s: there is no ground there (make the mesh cover the walk)")
     warnings += _walk_episodes(summary)
     if margin == -math.inf:
         warnings.append(f"fewer than three feet were in support at t = {when:.2f} s (free gait): the robot stood on no support polygon")

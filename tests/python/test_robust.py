@@ -225,10 +225,13 @@ def test_health_checks_flag_meaningless_runs():
         ({"max_penetration_m": 0.05}, "50.0 mm into the ground, more than 3 x the 2.3 mm"),
         ({"body_height_change_m": -0.3}, "the body fell by 300 mm"),
         ({"tracking_error_xy_max_m": 1.0}, "strayed 1.000 m"),
-        ({"distance_walked_m": 282.0}, "walked 282.000 m for a 0.900 m reference"),
+        ({"distance_walked_m": 282.0}, "walked 282.000 m for a 0.900 m reference path"),
         ({"energy_electrical_j": float("nan")}, "non-finite figures: energy_electrical_j"),
         ({"min_stability_margin_m": -0.004, "min_stability_margin_t_s": 12.5}, "stability margin fell to -4.0 mm at t = 12.50 s"),
         ({"min_stability_margin_m": float("-inf"), "min_stability_margin_t_s": 3.0}, "fewer than three feet were in support at t = 3.00 s"),
+        ({"foot_left_terrain": 2, "foot_left_terrain_t_s": 41.5}, "foot 2 went beyond the border of the terrain mesh at t = 41.50 s"),
+        # The desired pose halted with the walk (issue 37): the commanded path is the measure.
+        ({"commanded_path_length_m": 1.0, "distance_walked_m": 0.29, "reference_distance_m": 0.3}, "walked 0.290 m for a 1.000 m commanded path"),
     ]:
         warnings = health.check({**healthy, **change})
         assert len(warnings) == 1 and words in warnings[0], (change, warnings)
@@ -267,6 +270,9 @@ def test_health_sees_a_five_legged_walk_halted_for_good():
     deadlock = r.timeseries["deadlock"].to_numpy()
     assert deadlock[-1] == 1.0 and deadlock[r.timeseries.index.get_indexer([s["longest_deadlock_t_s"]], method="nearest")[0]] == 1.0
     assert any(w.startswith(f"the free gait was deadlocked for {s['longest_deadlock_s']:.2f} s") for w in s["warnings"]), s["warnings"]
+    # 200 s at 0.5 cm/s commanded; the body's net advance is about 0.14 m (issue 37).
+    assert s["commanded_path_length_m"] == pytest.approx(1.0, rel=1e-3) and s["net_displacement_m"] < 0.3
+    assert any("m commanded path" in w for w in s["warnings"]), s["warnings"]
     # The shipped walk (leg 5 failed) is healthy.
     assert hexadyn.simulate("free_gait_five_legs", progress=False).summary["warnings"] == []
 

@@ -122,3 +122,32 @@ fn shipped_terrain_walks() {
         }
     }
 }
+
+/// A mesh must cover the ground under the robot (issue 37): one that does not cover the start
+/// is refused before the settling, naming the foot, where it stands and the mesh file; a walk
+/// that leaves the mesh records the first foot beyond it and when (`hexadyn.health` warns).
+#[test]
+fn a_mesh_that_does_not_cover_the_feet_is_named() {
+    let tmp = std::env::temp_dir().join(format!("hexadyn-partial-mesh-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).unwrap();
+    let write = |name: &str, xs: &[f64]| {
+        let ys: Vec<f64> = (0..=40).map(|k| -2.0 + 0.1 * k as f64).collect();
+        let mut bytes = Vec::new();
+        ply::write(&generate::terraces(xs, &ys, |_, _| 0.0), ply::PlyFormat { encoding: ply::Encoding::Ascii, double: false }, &mut bytes).unwrap();
+        std::fs::write(tmp.join(name), bytes).unwrap();
+    };
+    // Ahead of the robot only.
+    write("ahead.ply", &[1.0, 1.5, 2.0]);
+    let e = parse_in(&short_walk("\n[terrain]\nkind = \"mesh\"\nfile = \"ahead.ply\"\n"), &tmp).and_then(|s| run_scenario(&s, |_| {}).map(|_| ())).expect_err("refused");
+    let message = e.to_string();
+    assert!(matches!(e, ScenarioError::OffTerrain { .. }) && message.contains("ahead.ply") && message.contains("beyond the border of the terrain mesh") && !message.contains('\n'), "{message}");
+    // Up to 2 cm ahead of the front feet: the 12 s walk at 1.5 cm/s leaves it.
+    let flat = run_scenario(&parse_in(&short_walk(""), &scenarios_dir()).unwrap(), |_| {}).unwrap();
+    let front = (0..6).map(|f| flat.series.column(&format!("foot_x[{f}]")).unwrap().values[0]).fold(f64::NEG_INFINITY, f64::max);
+    write("short.ply", &[-2.0, -1.0, 0.0, front + 0.02]);
+    let r = run_scenario(&parse_in(&short_walk("\n[terrain]\nkind = \"mesh\"\nfile = \"short.ply\"\n"), &tmp).unwrap(), |_| {}).unwrap();
+    std::fs::remove_dir_all(&tmp).unwrap();
+    let t = number(&r.summary, "foot_left_terrain_t_s");
+    assert!(t > 0.0 && t < 12.0, "left at {t} s");
+    assert!(!flat.summary.entries().iter().any(|(n, _)| n == "foot_left_terrain_t_s"));
+}

@@ -222,6 +222,13 @@ impl RobotModel {
         self.pids.is_some() || self.servos.is_some()
     }
 
+    /// The feet's centres (global frame) at the coordinates `q`.
+    pub fn foot_positions(&self, q: &[f64]) -> [Vector3<f64>; 6] {
+        let mut data = Data::new(&self.multibody);
+        mbs::kinematics(&self.multibody, &mut data, &q[..DOF], &[0.0; DOF]);
+        std::array::from_fn(|f| data.point(self.feet[f].0, &self.feet[f].1))
+    }
+
     /// Initial q for the given joint positions: body at (0, 0, Z) with zero yaw, parallel to the
     /// terrain below its origin (level on flat ground), Z chosen so that the lowest foot just
     /// touches the terrain (closest point: zero penetration); all other states zero.
@@ -231,13 +238,8 @@ impl RobotModel {
         // z_b = n: R_y(Θ) R_x(Ψ) e_z = (sin Θ cos Ψ, −sin Ψ, cos Θ cos Ψ) (Eq. 3.52 with Φ = 0).
         let n = self.terrain.height_normal(0.0, 0.0).1;
         (q[4], q[5]) = (n.x.atan2(n.z), (-n.y).asin());
-        let mut data = Data::new(&self.multibody);
-        let mut clearance = |q: &[f64]| {
-            mbs::kinematics(&self.multibody, &mut data, &q[..DOF], &[0.0; DOF]);
-            self.feet
-                .iter()
-                .map(|(body, point)| -self.terrain.proximity(&data.point(*body, point), self.options.ground.foot_radius).penetration)
-                .fold(f64::INFINITY, f64::min)
+        let clearance = |q: &[f64]| {
+            self.foot_positions(q).iter().map(|p| -self.terrain.proximity(p, self.options.ground.foot_radius).penetration).fold(f64::INFINITY, f64::min)
         };
         q[2] = -clearance(&q);
         // Off a plane the closest point is not below the foot: lowering the body by the

@@ -456,6 +456,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         control: mode,
         motions,
         gait,
+        terrain_file: terrain::mesh_file(raw.terrain.as_ref(), dir),
         terrain,
         ground_detection,
         origin: origin.to_string(),

@@ -103,6 +103,9 @@ pub enum ScenarioError {
     /// legs).
     #[error("{file}: settling tips the body over (pitch {pitch_deg:.1}°, roll {roll_deg:.1}°); check that the supporting feet surround the centre of mass (initial.lifted_legs)")]
     Tipped { file: String, pitch_deg: f64, roll_deg: f64 },
+    /// A foot stands beyond the border of the terrain mesh at the start.
+    #[error("{file}: foot {foot} stands at (x, y) = ({x:.3}, {y:.3}) m, beyond the border of the terrain mesh {terrain}: the mesh must cover the ground under the robot at the start (it stands centred on x = y = 0)")]
+    OffTerrain { file: String, terrain: String, foot: usize, x: f64, y: f64 },
     /// The progress callback asked to stop.
     #[error("{file}: stopped at t = {t:.3} s")]
     Stopped { file: String, t: f64 },
@@ -226,6 +229,8 @@ pub struct Scenario {
     pub gait: Option<GaitScenario>,
     /// The ground (`[terrain]`; flat at z = 0 without it).
     pub terrain: Arc<dyn Terrain>,
+    /// The PLY file of a mesh terrain, for the messages.
+    pub terrain_file: Option<String>,
     /// The ground detection experiment, in mode `ground_detection`.
     pub ground_detection: Option<GroundExperiment>,
     /// The scenario file (or origin name).

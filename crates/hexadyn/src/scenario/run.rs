@@ -92,12 +92,12 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
     let weight = plant.robot.model.multibody.total_mass() * crate::mbs::STANDARD_GRAVITY;
     let mut rec = Recorder::default();
     let mut stats = RunStats::default();
-    let mut gait_stats = GaitStats::default();
+    let mut gait_stats = s.gait.as_ref().map(|g| GaitStats::new(g.heading.source()));
     let mut last_t = 0.0;
     let flow = run_until(&mut plant, controller.as_mut(), s.duration, |p, meas, cmd| {
         let state = gait_state.as_ref().map(|g| g.borrow());
         stats.observe(p, cmd, supply, pi);
-        if let (Some(state), Some(g)) = (state.as_deref(), &s.gait) {
+        if let (Some(state), Some(g), Some(gait_stats)) = (state.as_deref(), &s.gait, gait_stats.as_mut()) {
             let normal: [f64; 6] = std::array::from_fn(|f| p.robot.outputs.contact[f].normal_force);
             gait_stats.observe(p.state().t, p.state().q.as_slice(), state, &normal, weight, &g.workspaces);
         }
@@ -115,8 +115,8 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
     }
 
     let mut summary = summarize(s, &plant, &stats, &q, started.elapsed().as_secs_f64());
-    if let (Some(g), Some(state)) = (&s.gait, &gait_state) {
-        summary.gait = Some(GaitSummary::new(g, &gait_stats, &state.borrow().diagnostics));
+    if let (Some(g), Some(state), Some(gait_stats)) = (&s.gait, &gait_state, &gait_stats) {
+        summary.gait = Some(GaitSummary::new(g, gait_stats, &state.borrow().diagnostics));
     }
     Ok((rec, summary))
 }
@@ -127,6 +127,11 @@ fn run(s: &Scenario, recorded: bool, mut after_row: impl FnMut(&mut Recorder) ->
 pub fn settled_robot(s: &Scenario) -> Result<SimulatedRobot> {
     let model = Arc::new(s.model());
     let mut q = model.touching_ground(&s.initial.joints);
+    let feet = model.foot_positions(&q);
+    if let Some(foot) = (0..6).find(|&f| !s.terrain.covers(feet[f].x, feet[f].y)) {
+        let terrain = s.terrain_file.clone().unwrap_or_else(|| "of [terrain]".into());
+        return Err(ScenarioError::OffTerrain { file: s.origin.clone(), terrain, foot, x: feet[foot].x, y: feet[foot].y });
+    }
     // The attitude of the body parallel to the ground, which the settling should keep.
     let (pitch0, roll0) = (q[4], q[5]);
     let mut qd = vec![0.0; q.len()];

@@ -7,6 +7,7 @@ use super::episodes::{Episode, WalkEpisodes};
 use super::gait::GaitScenario;
 use super::Scenario;
 use crate::control::gait::controller::GaitDiagnostics;
+use crate::control::gait::heading::HeadingSource;
 use crate::control::gait::pattern::FootCycle;
 use crate::control::gait::schedule::GaitState;
 use crate::control::Command;
@@ -85,6 +86,9 @@ pub struct Summary {
     pub max_tracking_error: Option<[f64; 3]>,
     /// Largest foot penetration into the ground.
     pub max_penetration_m: f64,
+    /// The first foot beyond the border of a terrain mesh (where there is no ground), and when
+    /// (s).
+    pub left_terrain: Option<(usize, f64)>,
     /// The penetration of three feet carrying the robot's weight at rest (Eq. 3.72): the scale
     /// of [`Self::max_penetration_m`] on this ground (2.3 mm on the ground of Table 3.3).
     pub static_penetration_m: f64,
@@ -142,6 +146,10 @@ impl Summary {
             v.extend(per_joint_entries(&self.joints, "max_tracking_error", errors, ("rad", "m")));
         }
         v.push((Cow::Borrowed("max_penetration_m"), Number(self.max_penetration_m)));
+        if let Some((foot, t)) = self.left_terrain {
+            v.push((Cow::Borrowed("foot_left_terrain"), Count(foot as u64)));
+            v.push((Cow::Borrowed("foot_left_terrain_t_s"), Number(t)));
+        }
         v.push((Cow::Borrowed("static_penetration_m"), Number(self.static_penetration_m)));
         if let Some(g) = &self.gait {
             v.push((Cow::Borrowed("gait_pattern"), Text(g.pattern.clone())));
@@ -153,6 +161,8 @@ impl Summary {
             v.push((Cow::Borrowed("tracking_error_yaw_max_rad"), Number(g.tracking_error_yaw_max_rad)));
             v.push((Cow::Borrowed("distance_walked_m"), Number(g.distance_walked_m)));
             v.push((Cow::Borrowed("reference_distance_m"), Number(g.reference_distance_m)));
+            v.push((Cow::Borrowed("commanded_path_length_m"), Number(g.commanded_path_length_m)));
+            v.push((Cow::Borrowed("net_displacement_m"), Number(g.net_displacement_m)));
             v.push((Cow::Borrowed("specific_resistance"), Number(specific_resistance(self.energy_electrical_j, self.robot_mass_kg, g.distance_walked_m))));
             v.push((Cow::Borrowed("clamped_ik_references"), Count(g.clamped_ik_references)));
             v.push((Cow::Borrowed("gait_switches"), Count(g.gait_switches)));
@@ -196,10 +206,15 @@ pub struct GaitSummary {
     pub tracking_error_xy_final_m: f64,
     /// Largest |yaw − yaw*| (rad).
     pub tracking_error_yaw_max_rad: f64,
-    /// Path length of the body centre (X, Y) and of its reference, sampled at the control
-    /// instants (m).
+    /// Path length of the body centre (X, Y), of its desired pose (which halts while the free
+    /// gait is deadlocked) and of the commanded heading ∫|V| dt, sampled at the control instants
+    /// (m). The first is Eq. 6.6's distance travelled, of the specific resistance.
     pub distance_walked_m: f64,
     pub reference_distance_m: f64,
+    pub commanded_path_length_m: f64,
+    /// Horizontal displacement of the body centre (X, Y) from the first control instant to the
+    /// last (m): without the sway and the back-and-forth that the path length counts.
+    pub net_displacement_m: f64,
     /// Foot references the inverse kinematics clamped into the joint ranges (count of leg
     /// updates).
     pub clamped_ik_references: u64,
@@ -230,7 +245,9 @@ impl GaitSummary {
             tracking_error_xy_max_m: stats.max_xy_error,
             tracking_error_xy_final_m: stats.final_xy_error,
             tracking_error_yaw_max_rad: stats.max_yaw_error,
-            distance_walked_m: stats.distance,
+            distance_walked_m: stats.path_length,
+            net_displacement_m: stats.net_displacement(),
+            commanded_path_length_m: stats.commanded_path_length,
             reference_distance_m: stats.reference_distance,
             clamped_ik_references: diagnostics.clamped_references as u64,
             gait_switches: diagnostics.gait_switches as u64,
@@ -270,11 +287,13 @@ pub(super) struct RunStats {
     cuts: u64,
     max_abs_voltage: f64,
     tracking: [f64; 3],
+    /// The first foot beyond the border of a terrain mesh, and when.
+    left_terrain: Option<(usize, f64)>,
 }
 
 impl Default for RunStats {
     fn default() -> Self {
-        RunStats { rows: 0, max_penetration: f64::NEG_INFINITY, commands: 0, saturated: 0, cuts: 0, max_abs_voltage: 0.0, tracking: [0.0; 3] }
+        RunStats { rows: 0, max_penetration: f64::NEG_INFINITY, commands: 0, saturated: 0, cuts: 0, max_abs_voltage: 0.0, tracking: [0.0; 3], left_terrain: None }
     }
 }
 
@@ -287,6 +306,10 @@ impl RunStats {
         let model = &p.robot.model;
         self.rows += 1;
         self.max_penetration = out.contact.iter().map(|c| c.penetration).fold(self.max_penetration, f64::max);
+        if self.left_terrain.is_none() {
+            let terrain = &p.robot.model.terrain;
+            self.left_terrain = (0..6).find(|&f| !terrain.covers(out.foot[f].x, out.foot[f].y)).map(|f| (f, p.state().t));
+        }
         for k in 0..JOINTS {
             self.commands += 1;
             if cmd.voltages[k].abs() >= supply {
@@ -358,6 +381,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         limit_switch_cuts: stats.cuts,
         max_tracking_error: s.control.tracks_references().then_some(stats.tracking),
         max_penetration_m: stats.max_penetration,
+        left_terrain: stats.left_terrain,
         static_penetration_m: s.model.ground.static_penetration(plant.robot.model.multibody.total_mass() * crate::mbs::STANDARD_GRAVITY / 3.0),
         gait: None,
     }
@@ -370,27 +394,55 @@ pub fn per_joint_entries(joints: &LegJoints, quantity: &str, values: [f64; 3], u
 }
 
 /// Gait figures of a run, accumulated row by row.
-#[derive(Clone, Debug)]
 pub(super) struct GaitStats {
     max_xy_error: f64,
     final_xy_error: f64,
     max_yaw_error: f64,
-    distance: f64,
+    /// Path lengths of the body and of its desired pose.
+    path_length: f64,
     reference_distance: f64,
+    /// The body's XY at the first instant.
+    start: Option<[f64; 2]>,
     last: Option<([f64; 2], [f64; 2])>,
+    /// The commanded heading, its path length ∫|V| dt (trapezoidal) and its last (t, |V|).
+    heading: Box<dyn HeadingSource>,
+    commanded_path_length: f64,
+    last_speed: Option<(f64, f64)>,
     min_feet: usize,
     max_outside: f64,
     min_stability_margin: Option<(f64, f64)>,
     episodes: WalkEpisodes,
 }
 
-impl Default for GaitStats {
-    fn default() -> Self {
-        GaitStats { max_xy_error: 0.0, final_xy_error: 0.0, max_yaw_error: 0.0, distance: 0.0, reference_distance: 0.0, last: None, min_feet: 6, max_outside: 0.0, min_stability_margin: None, episodes: WalkEpisodes::default() }
-    }
-}
-
 impl GaitStats {
+    /// Before the first instant, with the walk's heading source (its own instance).
+    pub(super) fn new(heading: Box<dyn HeadingSource>) -> Self {
+        GaitStats {
+            max_xy_error: 0.0,
+            final_xy_error: 0.0,
+            max_yaw_error: 0.0,
+            path_length: 0.0,
+            reference_distance: 0.0,
+            start: None,
+            last: None,
+            heading,
+            commanded_path_length: 0.0,
+            last_speed: None,
+            min_feet: 6,
+            max_outside: 0.0,
+            min_stability_margin: None,
+            episodes: WalkEpisodes::default(),
+        }
+    }
+
+    /// |(X, Y)| from the first instant to the last (m).
+    fn net_displacement(&self) -> f64 {
+        match (self.start, self.last) {
+            (Some(a), Some((b, _))) => (b[0] - a[0]).hypot(b[1] - a[1]),
+            _ => 0.0,
+        }
+    }
+
     /// One control instant `t`: body pose `q` (X, Y, Z, yaw, ...), the gait state, the feet's
     /// normal forces, the robot's weight (N) and the workspaces.
     pub(super) fn observe(&mut self, t: f64, q: &[f64], s: &GaitState, normal: &[f64; 6], weight: f64, workspaces: &[Workspace; 6]) {
@@ -404,10 +456,16 @@ impl GaitStats {
         let yaw = (q[3] - s.pose.angles.x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
         self.max_yaw_error = self.max_yaw_error.max(yaw.abs());
         if let Some((a, d)) = self.last {
-            self.distance += (actual[0] - a[0]).hypot(actual[1] - a[1]);
+            self.path_length += (actual[0] - a[0]).hypot(actual[1] - a[1]);
             self.reference_distance += (desired[0] - d[0]).hypot(desired[1] - d[1]);
         }
+        self.start.get_or_insert(actual);
         self.last = Some((actual, desired));
+        let speed = self.heading.heading(t).velocity.xy().norm();
+        if let Some((t0, v0)) = self.last_speed {
+            self.commanded_path_length += 0.5 * (v0 + speed) * (t - t0);
+        }
+        self.last_speed = Some((t, speed));
         self.min_feet = self.min_feet.min(feet_down);
         for (w, f) in workspaces.iter().zip(&s.feet) {
             self.max_outside = self.max_outside.max(w.distance_outside(f));

@@ -101,6 +101,12 @@ impl MeshTerrain {
 }
 
 impl Terrain for MeshTerrain {
+    /// A vertical ray from above meets a face.
+    fn covers(&self, x: f64, y: f64) -> bool {
+        let ray = Ray::new(PVec::new(x, y, self.top), PVec::new(0.0, 0.0, -1.0));
+        self.mesh.cast_local_ray(&ray, f64::MAX, false).is_some()
+    }
+
     /// A vertical ray from above; off the mesh's footprint, the closest point's height.
     fn height_normal(&self, x: f64, y: f64) -> (f64, Vector3<f64>) {
         let ray = Ray::new(PVec::new(x, y, self.top), PVec::new(0.0, 0.0, -1.0));

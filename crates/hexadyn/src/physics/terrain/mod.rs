@@ -231,6 +231,12 @@ pub trait Terrain: std::fmt::Debug + Send + Sync {
 
     /// The surface as triangles: a mesh's own; an analytic terrain's within `extent`.
     fn triangles(&self, extent: Extent) -> Triangles;
+
+    /// Whether there is ground below (x, y): everywhere on the analytic terrains and the
+    /// heightfields (extended beyond their grid), within its footprint for a mesh.
+    fn covers(&self, _x: f64, _y: f64) -> bool {
+        true
+    }
 }
 
 /// Horizontal ground at z = `height`.
