@@ -37,6 +37,10 @@ REFERENCE_POSE_COLUMNS = [f"{c}_ref" for c in POSE_COLUMNS]
 MAX_FRAMES = 50_000
 
 
+#: The most bytes of a row group decoded at a time (a block of its columns).
+READ_BYTES = 16 * 2**20
+
+
 def joint_columns(joints: vocabulary.Joints) -> list[str]:
     """The robot's three joints per leg, leg by leg (q_r, q_v, q_h on AMRU5): the generalized
     coordinates after the body pose, in the engine's order (Eq. 3.51)."""
@@ -163,7 +167,7 @@ class Run:
 
     def read(self, columns: list[str]) -> dict[str, np.ndarray]:
         """The given columns at the held rows (:attr:`rows`) as float arrays, read from the
-        Parquet file a row group at a time (not kept)."""
+        Parquet file a row group and a block of at most :data:`READ_BYTES` at a time (not kept)."""
         missing = [c for c in columns if c not in self.columns]
         if missing:
             raise ViewError(f"{self.folder / TIMESERIES_FILE}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
@@ -174,10 +178,12 @@ class Run:
                 for group, count in enumerate(self._group_rows):
                     end = int(np.searchsorted(self.rows, start + count))
                     if end > done:
-                        table = file.read_row_group(group, columns=columns, use_threads=False)
                         local = self.rows[done:end] - start
-                        for c in columns:
-                            out[c][done:end] = table.column(c).to_numpy()[local]
+                        step = max(1, READ_BYTES // (8 * count))
+                        for k in range(0, len(columns), step):
+                            block = file.read_row_group(group, columns=columns[k : k + step], use_threads=False)
+                            for c in block.column_names:
+                                out[c][done:end] = block.column(c).to_numpy()[local]
                         done = end
                     start += count
         except ValueError as exc:
