@@ -12,8 +12,8 @@
 //! [`MAX_MESH_TRIANGLES`] before anything is read, so that a file declaring more than it holds
 //! or than the bounds is refused at once. The peak of loading a terrain is parry's building of
 //! its mesh ([`MeshTerrain`]: a BVH, the pseudo-normals of the edges and vertices, hash maps
-//! while it builds them): 446 bytes per triangle measured on grids of 0.5 and 4 million
-//! triangles (2 triangles a vertex; 2025-11-28, 2-core Linux container, branch input-files),
+//! while it builds them): 446 bytes per triangle measured on grids of 2 and 4 million
+//! triangles (2 triangles a vertex; 2026-11-28, 2-core Linux container, commit e92dd69),
 //! so at most about 1.8 GB at the bounds; a file of vertices without faces takes 48 bytes a
 //! vertex.
 
