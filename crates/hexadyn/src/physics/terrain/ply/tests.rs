@@ -221,7 +221,7 @@ fn streaming_reads_what_the_whole_file_reader_reads() {
         let bytes = handmade(&t, encoding, "double", "uchar", "int");
         assert_eq!(parse(&bytes, "h.ply").unwrap(), whole_file_reading(&bytes), "{encoding:?}");
     }
-    let text = format!("ply\nformat ascii 1.0\nelement camera 2\nproperty float f\nproperty list uchar float k\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement edge 1\nproperty int a\nelement face 1\nproperty uchar flags\nproperty list uchar int vertex_indices\nelement empty 5\nend_header\n1 2 0.5 0.25\n2 0\n0 0 0\n1 0 0\n0 1 0\n7\n1 3 0 1 2\n\n\n\n\n\n");
+    let text = "ply\nformat ascii 1.0\nelement camera 2\nproperty float f\nproperty list uchar float k\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement edge 1\nproperty int a\nelement face 1\nproperty uchar flags\nproperty list uchar int vertex_indices\nelement empty 5\nend_header\n1 2 0.5 0.25\n2 0\n0 0 0\n1 0 0\n0 1 0\n7\n1 3 0 1 2\n\n\n\n\n\n";
     assert_eq!(parse(text.as_bytes(), "e.ply").unwrap(), whole_file_reading(text.as_bytes()));
 }
 
