@@ -431,7 +431,8 @@ def _is_json(value: Any, kind: type | None) -> bool:
 
 
 def _json_kind(value: Any) -> str:
-    return next(name for kind, name in _JSON_NAMES.items() if kind is not None and type(value) is kind) if value is not None else "null"
+    """The JSON type name of a value read from JSON."""
+    return _JSON_NAMES[None] if value is None else _JSON_NAMES.get(type(value), type(value).__name__)
 
 
 def _shown(value: Any) -> str:

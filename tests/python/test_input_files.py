@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import hexadyn
-from hexadyn import inputs, report
+from hexadyn import inputs
 from hexadyn.results import METADATA_FILE
 
 from conftest import shortened

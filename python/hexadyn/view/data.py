@@ -124,11 +124,12 @@ class Run:
         self.name: str = self.metadata.get("scenario_name") or self.folder.name
         #: The instants of the file, and the rows of it held (indices into the file).
         self.instants = sum(self._group_rows)
-        self.rows = decimation(self.instants, max_frames)
         if self.instants < 1:
             raise ViewError(f"{table_path}: no rows")
+        self.rows = decimation(self.instants, max_frames)
 
-        #: Where the body pose comes from: "recorded", "reference" (the controller's) or "still".
+        # Where the body pose comes from (`body_source`): "recorded", "reference" (the
+        # controller's, a run on the robot) or "still" (neither).
         if self._present(POSE_COLUMNS):
             pose, self.body_source = POSE_COLUMNS, "recorded"
         elif all(c in self.columns for c in REFERENCE_POSE_COLUMNS):
@@ -161,16 +162,19 @@ class Run:
         """Whether the optional `columns` are recorded: all (True) or none (False); ViewError
         naming the missing ones otherwise."""
         missing = [c for c in columns if c not in self.columns]
-        if missing and len(missing) < len(columns):
-            raise ViewError(f"{self.folder / TIMESERIES_FILE}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
+        if len(missing) < len(columns):
+            self._refuse_missing(missing)
         return not missing
+
+    def _refuse_missing(self, missing: list[str]) -> None:
+        """ViewError naming the `missing` columns, if any."""
+        if missing:
+            raise ViewError(f"{self.folder / TIMESERIES_FILE}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
 
     def read(self, columns: list[str]) -> dict[str, np.ndarray]:
         """The given columns at the held rows (:attr:`rows`) as float arrays, read from the
         Parquet file a row group and a block of at most :data:`READ_BYTES` at a time (not kept)."""
-        missing = [c for c in columns if c not in self.columns]
-        if missing:
-            raise ViewError(f"{self.folder / TIMESERIES_FILE}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)}")
+        self._refuse_missing([c for c in columns if c not in self.columns])
         out = {c: np.empty(self.rows.size) for c in columns}
         try:
             with open_series(self.folder / TIMESERIES_FILE) as file:
