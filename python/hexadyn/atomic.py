@@ -5,7 +5,8 @@ file system), sync it to disk and rename it to the target. A failure removes the
 leaves an existing target untouched. The temporaries are named ``.NAME.PID.XXXXXXXX.partial``
 (``.old`` for a replaced folder on its way out), PID being the writing process: a process killed
 while writing (``kill -9``, a power cut) cannot remove its temporary, so every write first
-removes the temporaries in its folder whose process is gone (:func:`remove_stale`). Used for
+removes the temporaries in its folder whose process is gone (:func:`remove_stale`), and every
+``hexadyn`` command those of the results root (``results/``, :mod:`hexadyn.cli`). Used for
 results folders (:mod:`hexadyn.report`), the friction comparison (:mod:`hexadyn.compare`) and
 the Monte Carlo files (:mod:`hexadyn.montecarlo`, whose table and figures are one set of files
 in the campaign folder: :func:`write_files`).

@@ -13,14 +13,13 @@ from pathlib import Path
 import click
 
 import hexadyn
-from hexadyn.runner import free_results_folder
+from hexadyn import atomic
+from hexadyn.runner import RESULTS_ROOT, free_results_folder
 
 #: Scenario run by `hexadyn simulate` without an argument (and by `make run`): a shipped scenario
 #: name or a path. The validation test case of Table 6.2 (tripod, T = 12 s, 5 steps, 5 % overlap)
 #: at V_x = 1.5 cm/s with LuGre friction: 60 s of walking.
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
-
-#: Folder under which `hexadyn simulate` writes results when no --out is given.
 
 # Exceptions that report bad input (a missing file, a wrong value in a scenario) rather than a
 # bug: they are shown as one clean line.
@@ -35,6 +34,9 @@ class HexadynGroup(click.Group):
     """A click group that turns user errors raised by any command into one-line messages."""
 
     def invoke(self, ctx: click.Context):
+        # A run killed while saving (kill -9, a power cut) could not remove its temporary
+        # folder: every command first removes those whose writer is gone from the results root.
+        atomic.remove_stale(RESULTS_ROOT)
         try:
             return super().invoke(ctx)
         except USER_ERRORS as exc:

@@ -18,6 +18,7 @@ A complete results folder, with the power tables and the figures, is written ato
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import errno
 import functools
@@ -25,13 +26,15 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Iterator, Mapping, Sequence
 
+from hexadyn import inputs
 from hexadyn._core import __version__
 from hexadyn.vocabulary import Joints
 
 if TYPE_CHECKING:  # pandas is imported when needed (keeps `import hexadyn` light)
     import pandas as pd
+    import pyarrow.parquet as pq
 
 TIMESERIES_FILE = "timeseries.parquet"
 METADATA_FILE = "metadata.json"
@@ -44,6 +47,24 @@ IN_MEMORY_LIMIT_BYTES = 400 * 2**20
 #: Identifies a hexadyn results folder in metadata.json.
 FORMAT = "hexadyn-results"
 FORMAT_VERSION = 1
+#: The keys of ``metadata.json`` and the JSON types their values may have (None: null); a key
+#: may be absent, but for ``format``. The values of ``units`` and ``descriptions`` are strings,
+#: as are the items of ``columns``.
+METADATA_TYPES: dict[str, tuple[type | None, ...]] = {
+    "format": (str,),
+    "format_version": (int,),
+    "hexadyn_version": (str,),
+    "created": (str,),
+    "scenario_name": (str, None),
+    "scenario_path": (str, None),
+    "scenario": (str,),
+    "model": (dict,),
+    "robot_source": (str, None),
+    "robot": (str,),
+    "units": (dict,),
+    "descriptions": (dict,),
+    "columns": (list,),
+}
 #: The size of a row group of ``timeseries.parquet`` (8-byte values), and so about the memory
 #: a streamed run holds before writing. INTERPRETATION: the issue bounds the memory of a run,
 #: not the size of a row group. pyarrow's writer keeps about 0.9 kB of footer per column and
@@ -144,9 +165,8 @@ class Results:
         """(instants, columns) of the time series, without reading it."""
         if self._timeseries is not None:
             return self._timeseries.shape
-        import pyarrow.parquet as pq
-
-        meta = pq.ParquetFile(self._series_file()).metadata
+        with open_series(self._series_file()) as file:
+            meta = file.metadata
         return meta.num_rows, meta.num_columns - 1  # t is the index
 
     @property
@@ -168,10 +188,9 @@ class Results:
         if self._timeseries is not None:
             return self._timeseries.iloc[[0, -1]]
         import pyarrow as pa
-        import pyarrow.parquet as pq
 
-        file = pq.ParquetFile(self._series_file())
-        ends = pa.concat_tables([_read_row(file, 0, 0), _read_row(file, file.num_row_groups - 1, -1)])
+        with open_series(self._series_file()) as file:
+            ends = pa.concat_tables([_read_row(file, 0, 0), _read_row(file, file.num_row_groups - 1, -1)])
         return ends.to_pandas()
 
     def _series_file(self) -> Path:
@@ -225,21 +244,9 @@ class Results:
         """Reads a results folder (written by :func:`hexadyn.report.save`); the time series is
         read on first access. Raises ValueError naming the file for a broken folder."""
         folder = Path(folder)
-        meta_path = folder / METADATA_FILE
-        if not meta_path.is_file():
-            if not folder.is_dir():
-                raise FileNotFoundError(errno.ENOENT, "no such results folder", str(folder))
-            raise ValueError(f"{folder}: not a hexadyn results folder (no {METADATA_FILE})")
-        metadata = _read_json_object(meta_path, "hexadyn results metadata")
-        if metadata.get("format") != FORMAT:
-            raise ValueError(f"{meta_path}: not hexadyn results metadata (format {metadata.get('format')!r}, expected {FORMAT!r})")
-        for key, kind in (("units", dict), ("descriptions", dict), ("scenario", str), ("robot", str)):
-            if key in metadata and not isinstance(metadata[key], kind):
-                raise ValueError(f"{meta_path}: {key} is a {type(metadata[key]).__name__}; expected a JSON {'object' if kind is dict else 'string'}")
+        metadata = read_metadata(folder)
         summary = _read_json_object(folder / SUMMARY_FILE, "the run's summary")
-        series = folder / TIMESERIES_FILE
-        if not series.is_file():
-            raise ValueError(f"{series}: {'a directory' if series.is_dir() else 'missing'}; expected the Parquet file of the time series")
+        inputs.check_input(_existing(folder / TIMESERIES_FILE, "the Parquet file of the time series"), limit=None)
         metadata.pop("columns", None)
         return cls(None, metadata.get("units", {}), summary, metadata, path=folder)
 
@@ -343,29 +350,95 @@ def _read_row(file: Any, group: int, index: int) -> Any:
     return pa.Table.from_pydict(row, schema=file.schema_arrow)
 
 
-def _read_parquet(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
+def read_metadata(folder: str | os.PathLike) -> dict[str, Any]:
+    """The ``metadata.json`` of a results folder, every known key of the type
+    :data:`METADATA_TYPES` gives it; ValueError naming the file, the key, the value and what is
+    allowed otherwise (FileNotFoundError if there is no such folder)."""
+    folder = Path(folder)
+    path = folder / METADATA_FILE
+    if not os.path.lexists(path):
+        if not folder.is_dir():
+            raise FileNotFoundError(errno.ENOENT, "no such results folder", str(folder))
+        raise ValueError(f"{folder}: not a hexadyn results folder (no {METADATA_FILE})")
+    metadata = _read_json_object(path, "hexadyn results metadata")
+    if metadata.get("format") != FORMAT:
+        raise ValueError(f"{path}: not hexadyn results metadata (format {metadata.get('format')!r}, expected {FORMAT!r})")
+    for key, kinds in METADATA_TYPES.items():
+        if key in metadata and not any(_is_json(metadata[key], kind) for kind in kinds):
+            raise ValueError(f"{path}: `{key}` = {_shown(metadata[key])}: a JSON {_json_kind(metadata[key])}; allowed: {' or '.join(f'a JSON {_JSON_NAMES[k]}' for k in kinds)}")
+    for key, what in (("units", "values"), ("descriptions", "values"), ("columns", "items")):
+        items = metadata.get(key, ())
+        for item in items.values() if isinstance(items, dict) else items:
+            if not isinstance(item, str):
+                raise ValueError(f"{path}: `{key}` holds {_shown(item)}, a JSON {_json_kind(item)}; allowed: strings as its {what}")
+    return metadata
+
+
+@contextlib.contextmanager
+def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
+    """The Parquet file of a time series, opened as an input file
+    (:func:`hexadyn.inputs.open_input`) and closed on leaving; ValueError naming it if it is
+    missing or not a Parquet file."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    if not path.is_file():
-        raise ValueError(f"{path}: {'a directory' if path.is_dir() else 'missing'}; expected the Parquet file of the time series")
-    try:
-        return pq.read_table(path, columns=columns).to_pandas()
-    except (pa.ArrowException, OSError) as exc:
-        raise ValueError(f"{path}: not a readable time series: {exc}") from None
+    with inputs.open_input(_existing(path, "the Parquet file of the time series"), limit=None) as source:
+        try:
+            file = pq.ParquetFile(source)
+        except (pa.ArrowException, OSError) as exc:
+            raise ValueError(f"{path}: not a readable time series: {exc}") from None
+        yield file
+
+
+def _existing(path: Path, what: str) -> Path:
+    """`path`, ValueError saying `what` is missing if there is nothing there."""
+    if not os.path.lexists(path):
+        raise ValueError(f"{path}: missing; expected {what}")
+    return path
+
+
+def _read_parquet(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
+    import pyarrow as pa
+
+    with open_series(path) as file:
+        try:
+            return file.read(columns=columns).to_pandas()
+        except (pa.ArrowException, OSError) as exc:
+            raise ValueError(f"{path}: not a readable time series: {exc}") from None
 
 
 def _read_json_object(path: Path, what: str) -> dict[str, Any]:
-    """A JSON file holding an object; ValueError naming the file otherwise."""
+    """A JSON file holding an object (an input file, :func:`hexadyn.inputs.read_text`);
+    ValueError naming the file otherwise."""
     try:
-        value = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ValueError(f"{path}: missing ({what})") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        value = json.loads(inputs.read_text(_existing(path, f"{what} ({path.name})")))
+    except json.JSONDecodeError as exc:
         raise ValueError(f"{path}: not valid JSON ({what}): {exc}") from None
     if not isinstance(value, dict):
-        raise ValueError(f"{path}: a JSON {type(value).__name__}; expected an object ({what})")
+        raise ValueError(f"{path}: a JSON {_json_kind(value)}; expected an object ({what})")
     return value
+
+
+#: JSON type names of the Python types :mod:`json` reads.
+_JSON_NAMES: dict[type | None, str] = {dict: "object", list: "array", str: "string", int: "integer", float: "number", bool: "boolean", None: "null"}
+
+
+def _is_json(value: Any, kind: type | None) -> bool:
+    """Whether `value` read from JSON is of `kind` (None: null; a boolean is not an integer)."""
+    if kind is None:
+        return value is None
+    return isinstance(value, kind) and not (kind is int and isinstance(value, bool))
+
+
+def _json_kind(value: Any) -> str:
+    """The JSON type name of a value read from JSON."""
+    return _JSON_NAMES[None] if value is None else _JSON_NAMES.get(type(value), type(value).__name__)
+
+
+def _shown(value: Any) -> str:
+    """A JSON value on one line, at most 60 characters."""
+    text = json.dumps(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _json_safe(value: Any) -> Any:

@@ -14,7 +14,7 @@ import shutil
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence, Union
 
-from hexadyn import atomic
+from hexadyn import atomic, inputs
 from hexadyn.results import IN_MEMORY_LIMIT_BYTES, TIMESERIES_FILE, Results, SeriesWriter
 
 #: Folder of the scenario files shipped with the package.
@@ -46,7 +46,9 @@ def resolve_scenario(scenario: str | os.PathLike) -> Path:
     """The scenario file for a path or the name of a shipped scenario.
 
     An existing file wins; otherwise a bare name (no folder) is looked up among the shipped
-    scenarios, with or without ``.toml``. Raises FileNotFoundError naming the shipped scenarios.
+    scenarios, with or without ``.toml``. Raises FileNotFoundError naming the shipped scenarios,
+    or ValueError saying what `scenario` is if it is there but not a regular file (a named pipe,
+    a directory...).
     """
     path = Path(scenario)
     if path.is_file():
@@ -57,6 +59,8 @@ def resolve_scenario(scenario: str | os.PathLike) -> Path:
         shipped = SCENARIOS_DIR / f"{stem}.toml"
         if shipped.is_file():
             return shipped
+    if os.path.lexists(path):
+        inputs.check_input(path)  # not a regular file: says what it is
     names = ", ".join(list_scenarios())
     raise FileNotFoundError(errno.ENOENT, f"no such scenario file, nor a shipped scenario ({names})", text)
 

@@ -13,6 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from hexadyn import inputs
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -106,8 +108,8 @@ def import_urdf(
     else:
         origin = os.fspath(drives)
         try:
-            template = Path(drives).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
+            template = inputs.read_text(drives)
+        except OSError as exc:
             raise ValueError(f"{origin}: cannot read the drives' description: {exc}") from None
     robot = UrdfHexapod.from_file(os.fspath(urdf))
     header = (
@@ -134,8 +136,8 @@ def _robot_text(robot: str | os.PathLike, out: str | os.PathLike, overwrite: boo
         return shipped_robot_text(name), name, target
     except ValueError:
         try:
-            return Path(robot).read_text(encoding="utf-8"), name, target
-        except (OSError, UnicodeDecodeError) as exc:
+            return inputs.read_text(robot), name, target
+        except OSError as exc:
             raise ValueError(f"{name}: cannot read the robot description: {exc}") from None
 
 

@@ -396,9 +396,9 @@ def test_subprocesses_print_one_line_and_no_traceback(base_log, walk, stored_cam
     (corrupt / DATABASE_FILE).write_bytes(data[: len(data) // 2])
     cases = [
         (["identify", str(log), "--out", str(tmp_path / "a")], f"{log}: column `i_q_v[1]`, row 7"),
-        (["identify", str(log), "--robot", "/dev/zero", "--out", str(tmp_path / "b")], "/dev/zero: robot description: not a regular file"),
+        (["identify", str(log), "--robot", "/dev/zero", "--out", str(tmp_path / "b")], "/dev/zero: a device, not a regular file"),
         (["montecarlo", str(walk), "--runs", "999999999999", "--out", str(tmp_path / "c")], "runs per velocity = 999999999999"),
-        (["montecarlo", str(walk), "--friction-stats", "/dev/zero", "--out", str(tmp_path / "d")], "/dev/zero: friction statistics: not a regular file"),
+        (["montecarlo", str(walk), "--friction-stats", "/dev/zero", "--out", str(tmp_path / "d")], "/dev/zero: a device, not a regular file"),
         (["montecarlo", str(walk), "--friction-stats", str(stats), "--out", str(tmp_path / "e")], "keeps a draw with probability 4.43e-13"),
         (["montecarlo", str(walk), "--velocities", "1", "--runs", "3", "--variants", "dry_viscous", "--seed", "1", "--no-progress", "--out", str(corrupt)], "not a readable campaign database"),
     ]

@@ -178,10 +178,10 @@ def test_a_broken_results_folder_is_one_line(results_folder, tmp_path, edit, wor
 def test_a_device_or_a_fifo_as_robot_file_fails_at_once(frame, tmp_path):
     path = tmp_path / "log.csv"
     frame.to_csv(path, index=False)
-    assert_one_line_error(invoke(str(path), "--robot", "/dev/zero", "--out", str(tmp_path / "a")), "/dev/zero: robot description: not a regular file")
+    assert_one_line_error(invoke(str(path), "--robot", "/dev/zero", "--out", str(tmp_path / "a")), "/dev/zero: a device, not a regular file")
     fifo = tmp_path / "robot.fifo"
     os.mkfifo(fifo)
-    assert_one_line_error(invoke(str(path), "--robot", str(fifo), "--out", str(tmp_path / "b")), f"{fifo}: robot description: not a regular file")
+    assert_one_line_error(invoke(str(path), "--robot", str(fifo), "--out", str(tmp_path / "b")), f"{fifo}: a named pipe (FIFO), not a regular file")
     garbage = tmp_path / "robot.toml"
     garbage.write_bytes(b"\xff\xfe not text")
-    assert_one_line_error(invoke(str(path), "--robot", str(garbage), "--out", str(tmp_path / "c")), f"{garbage}: robot description: not UTF-8 text (invalid byte at offset 0)")
+    assert_one_line_error(invoke(str(path), "--robot", str(garbage), "--out", str(tmp_path / "c")), f"{garbage}: not UTF-8 text (invalid byte at offset 0)")

@@ -102,7 +102,7 @@ def test_a_device_as_friction_statistics_fails_at_once(scenario, tmp_path, name)
     path = Path(name) if name.startswith("/") else tmp_path / name
     if not path.exists():
         os.mkfifo(path)
-    assert_one_line_error(invoke(str(scenario), "--out", str(tmp_path / "mc"), "--friction-stats", str(path)), f"{path}: friction statistics: not a regular file")
+    assert_one_line_error(invoke(str(scenario), "--out", str(tmp_path / "mc"), "--friction-stats", str(path)), f"{path}: " + ("a device" if name.startswith("/") else "a named pipe (FIFO)") + ", not a regular file")
 
 
 # ---------------------------------------------------------------------------------------------

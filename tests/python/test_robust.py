@@ -392,11 +392,14 @@ def saved(tmp_path_factory) -> Path:
 @pytest.mark.parametrize(
     "file, content, words",
     [
-        ("summary.json", "[1, 2]", "summary.json: a JSON list; expected an object"),
+        ("summary.json", "[1, 2]", "summary.json: a JSON array; expected an object"),
         ("summary.json", "{broken", "summary.json: not valid JSON"),
-        ("metadata.json", '{"format": "hexadyn-results", "units": [1]}', "metadata.json: units is a list"),
-        ("metadata.json", "[]", "metadata.json: a JSON list"),
-        ("metadata.json", "\xff", "metadata.json: not valid JSON"),
+        ("metadata.json", '{"format": "hexadyn-results", "units": [1]}', "metadata.json: `units` = [1]: a JSON array; allowed: a JSON object"),
+        ("metadata.json", '{"format": "hexadyn-results", "robot": 5}', "metadata.json: `robot` = 5: a JSON integer; allowed: a JSON string"),
+        ("metadata.json", '{"format": "hexadyn-results", "scenario_path": 5}', "metadata.json: `scenario_path` = 5: a JSON integer; allowed: a JSON string or a JSON null"),
+        ("metadata.json", '{"format": "hexadyn-results", "units": {"t": 1}}', "metadata.json: `units` holds 1, a JSON integer; allowed: strings as its values"),
+        ("metadata.json", "[]", "metadata.json: a JSON array"),
+        ("metadata.json", "\xff", "metadata.json: not UTF-8 text (invalid byte at offset 0)"),
     ],
 )
 def test_broken_results_files_are_named_in_one_line(saved: Path, tmp_path: Path, file: str, content: str, words: str):

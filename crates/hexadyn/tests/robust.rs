@@ -105,6 +105,39 @@ fn a_duplicate_key_is_named() {
     }
 }
 
+/// A named pipe named as any input file is refused at once, saying what it is (opening one for
+/// reading used to wait for a writer, for ever and deaf to Ctrl-C). The reads run on a thread
+/// so that a hang fails the test instead of blocking it.
+#[test]
+fn named_pipes_are_refused_without_waiting() {
+    let dir = std::env::temp_dir().join(format!("hexadyn-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("pipe");
+    let name = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(name.as_ptr(), 0o600) }, 0, "mkfifo");
+    let shown = fifo.display().to_string();
+    let cases = [
+        ("scenario.robot", with("stand_six_legs", "robot = \"amru5\"", &format!("robot = \"{shown}\""))),
+        ("terrain.file", with("free_gait_rough_spline", "file = \"terrains/rough_ground.ply\"", &format!("file = \"{shown}\""))),
+        ("terrain.file", with("stand_six_legs", "[control]", &format!("[terrain]\nkind = \"heightfield\"\nfile = \"{shown}\"\nspacing_m = 0.1\n\n[control]"))),
+        ("gait.heading.file", with("validation_tripod_1_5cm", "kind = \"constant\"\nvx_m_s = 0.015\nvy_m_s = 0.0\nomega_z_rad_s = 0.0", &format!("kind = \"csv\"\nfile = \"{shown}\"\n"))),
+    ];
+    let (sender, receiver) = std::sync::mpsc::channel();
+    let path = fifo.clone();
+    std::thread::spawn(move || {
+        let mut messages: Vec<String> = cases.iter().map(|(field, text)| rejected(text, field)).collect();
+        messages.push(Scenario::from_file(&path).unwrap_err().to_string());
+        messages.push(hexadyn::link::LinkConfig::from_file(&path).unwrap_err().to_string());
+        sender.send(messages).unwrap();
+    });
+    let messages = receiver.recv_timeout(std::time::Duration::from_secs(60)).expect("reading a named pipe blocked");
+    for m in &messages {
+        assert!(m.contains(&format!("{shown}: ")) || m.contains(&format!("\"{shown}\"")), "{m}");
+        assert!(m.contains("a named pipe (FIFO), not a regular file; allowed: a regular file of at most "), "{m}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn input_files_are_bounded_regular_files() {
     // A device: refused at once instead of read until memory runs out.

@@ -37,7 +37,7 @@ def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overw
         atomic.refuse_existing(out, "identification folder")
     robot_text = None
     if robot is not None:
-        robot_text = inputs.read_text(robot, "robot description")
+        robot_text = inputs.read_text(robot)
         _core.robot_properties(robot_text, str(robot))  # an invalid description is named now, by its file
     # The bar is drawn on a terminal only and erased when done: an error stays one line.
     with tqdm(total=2 * len(logs), desc="identify", unit="step", leave=False, disable=None) as bar:

@@ -9,6 +9,8 @@ import errno
 import os
 from pathlib import Path
 
+from hexadyn import inputs
+
 #: The shipped link configuration on the loopback interface (``--link loopback``).
 LOOPBACK = Path(__file__).resolve().parent / "loopback.toml"
 
@@ -16,10 +18,13 @@ __all__ = ["LOOPBACK", "resolve_link"]
 
 
 def resolve_link(link: str | os.PathLike) -> Path:
-    """The link configuration file for a path, or ``"loopback"`` for :data:`LOOPBACK`."""
+    """The link configuration file for a path, or ``"loopback"`` for :data:`LOOPBACK`; ValueError
+    saying what it is for a path that is not a regular file (a named pipe, a directory...)."""
     path = Path(link)
     if path.is_file():
         return path
     if os.fspath(link) == "loopback":
         return LOOPBACK
+    if os.path.lexists(path):
+        inputs.check_input(path)  # not a regular file: says what it is
     raise FileNotFoundError(errno.ENOENT, "no such link configuration file (or \"loopback\" for the shipped one)", os.fspath(link))

@@ -171,7 +171,7 @@ def read_friction_stats(path: str | os.PathLike) -> dict[str, tuple[float, float
 
     path = Path(path)
     try:
-        table = tomllib.loads(inputs.read_text(path, "friction statistics")).get("friction_stats")
+        table = tomllib.loads(inputs.read_text(path)).get("friction_stats")
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: cannot read the friction statistics: {exc}") from exc
     if not isinstance(table, dict) or not table:

@@ -55,7 +55,8 @@ class Viewer:
     def _build_panel(self) -> None:
         gui, run = self.server.gui, self.run
         gui.configure_theme(control_width="large", dark_mode=False, show_logo=False, show_share_button=False)  # loopback only
-        gui.add_markdown(f"**{html.escape(run.name)}**  \n{run.duration:g} s, {run.t.size} frames")
+        frames = f"{run.t.size} frames" + (f" of {run.instants} instants" if run.t.size < run.instants else "")
+        gui.add_markdown(f"**{html.escape(run.name)}**  \n{run.duration:g} s, {frames}" + BODY_NOTES[run.body_source] + ("" if run.has_forces else "  \nno ground forces recorded"))
         with gui.add_folder("Playback"):
             step = float(np.median(np.diff(run.t))) if run.t.size > 1 else 1.0
             self.time_slider = gui.add_slider("Time (s)", min=float(run.t[0]), max=float(max(run.t[-1], run.t[0] + step)), step=step, initial_value=float(run.t[0]))
@@ -143,7 +144,7 @@ class Viewer:
 
     def _show_panel(self) -> None:
         self.time_slider.value = self.frame.t
-        self.readout.content = _readout(self.frame)
+        self.readout.content = _readout(self.frame, self.run.has_forces)
         self._last_panel = time.monotonic()
 
     def _follow(self, body: np.ndarray) -> None:
@@ -183,15 +184,23 @@ class Viewer:
                     self.pause()
 
 
+#: What the panel says of a body pose that was not recorded (:attr:`Run.body_source`).
+BODY_NOTES = {
+    "recorded": "",
+    "reference": "  \nbody: the controller's reference pose (no measured pose)",
+    "still": "  \nbody: not recorded, shown still at the origin",
+}
+
 #: Phase code -> name for the read-out (the free gait's failed leg included).
 PHASE_NAMES = {code: name for name, code in PHASE_CODES.items()}
 
 
-def _readout(frame: Frame) -> str:
-    """The state read-out: a table for people, data attributes for scripts."""
+def _readout(frame: Frame, forces: bool) -> str:
+    """The state read-out: a table for people, data attributes for scripts; F_z blank when the
+    run recorded no `forces`."""
     feet = frame.feet
     rows = "".join(
-        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{frame.forces[leg, 2]:.1f}</td><td>{PHASE_NAMES.get(int(frame.phases[leg]), '')}</td></tr>"
+        f"<tr><td>{leg}</td><td>{feet[leg, 0]:.4f}</td><td>{feet[leg, 1]:.4f}</td><td>{feet[leg, 2]:.4f}</td><td>{f'{frame.forces[leg, 2]:.1f}' if forces else ''}</td><td>{PHASE_NAMES.get(int(frame.phases[leg]), '')}</td></tr>"
         for leg in range(LEGS)
     )
     attributes = f'data-t="{frame.t!r}" data-index="{frame.index}" data-feet="{html.escape(json.dumps(feet.tolist()))}"'

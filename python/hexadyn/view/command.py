@@ -11,9 +11,9 @@ import click
 @click.command()
 @click.argument("folder", type=click.Path(path_type=Path))
 @click.option("--html", "html_file", type=click.Path(dir_okay=False, path_type=Path), default=None, help="Write a self-contained HTML export (plays from a file:// URL or any static web server) instead of serving.")
-@click.option("--port", type=click.IntRange(1, 65535), default=None, help="Port on 127.0.0.1 (default: a free one).")
+@click.option("--port", type=click.IntRange(0, 65535), default=0, show_default=True, help="Port on 127.0.0.1: taken is an error; 0 for any free one (the URL printed says which).")
 @click.option("--no-open", is_flag=True, help="Do not open a browser (headless use): only print the URL.")
-def view(folder: Path, html_file: Path | None, port: int | None, no_open: bool) -> None:
+def view(folder: Path, html_file: Path | None, port: int, no_open: bool) -> None:
     """Watch the run in results FOLDER: a 3D animation in the browser with the time plots.
 
     Serves the viewer on http://127.0.0.1:PORT/ until Ctrl-C and opens it in the browser:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from hexadyn import atomic
 from hexadyn.view.data import Run
 
 #: Frames per simulated second recorded, and the most frames an export holds.
@@ -49,7 +50,5 @@ def export_html(folder: str | Path, file: str | Path, fps: float = EXPORT_FPS, m
     finally:
         stop_quietly(server)
     file.parent.mkdir(parents=True, exist_ok=True)
-    tmp = file.with_name(f".{file.name}.tmp")
-    tmp.write_text(page, encoding="utf-8")
-    tmp.replace(file)
+    atomic.write_file(file, lambda tmp: tmp.write_text(page, encoding="utf-8"))
     return file

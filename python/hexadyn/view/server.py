@@ -1,18 +1,19 @@
-"""A local viewer server (loopback only) on a free port: :func:`start` for scripts and tests,
-:func:`serve` for ``hexadyn view`` (prints the URL, opens the browser, runs until Ctrl-C)."""
+"""A local viewer server (loopback only), on the port asked or any free one (port 0):
+:func:`start` for scripts and tests, :func:`serve` for ``hexadyn view`` (prints the URL, opens
+the browser, runs until Ctrl-C). A port asked for that is taken is an error: viser would
+silently serve on the next free one."""
 
 from __future__ import annotations
 
 import contextlib
 import io
 import logging
-import socket
 import webbrowser
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
-from hexadyn.view.data import Run
+from hexadyn.view.data import Run, ViewError
 
 if TYPE_CHECKING:  # viser is imported when a viewer starts
     import viser
@@ -22,20 +23,18 @@ if TYPE_CHECKING:  # viser is imported when a viewer starts
 HOST = "127.0.0.1"
 
 
-def free_port(host: str = HOST) -> int:
-    """A TCP port nobody listens on right now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind((host, 0))
-        return int(s.getsockname()[1])
-
-
-def viser_server(port: int | None = None) -> "viser.ViserServer":
-    """A viser server on 127.0.0.1 (a free port unless `port`), without viser's banner on stdout."""
+def viser_server(port: int = 0) -> "viser.ViserServer":
+    """A viser server on 127.0.0.1, on `port` or, for 0, any free port (the OS's choice, read back
+    with ``get_port()``), without viser's banner on stdout. ViewError if `port` is taken."""
     import viser
 
     logging.getLogger("websockets").setLevel(logging.WARNING)
     with contextlib.redirect_stdout(io.StringIO()):
-        return viser.ViserServer(host=HOST, port=port or free_port(), verbose=False)
+        server = viser.ViserServer(host=HOST, port=port, verbose=False)
+    if port and server.get_port() != port:
+        stop_quietly(server)
+        raise ViewError(f"--port {port}: taken on {HOST}; allowed: a free port, or 0 for any free one")
+    return server
 
 
 def stop_quietly(server: "viser.ViserServer") -> None:
@@ -57,8 +56,8 @@ class RunningViewer:
         stop_quietly(self.server)
 
 
-def start(folder: str | Path, port: int | None = None) -> RunningViewer:
-    """Starts a viewer of the results `folder` on 127.0.0.1 (a free port unless `port`)."""
+def start(folder: str | Path, port: int = 0) -> RunningViewer:
+    """Starts a viewer of the results `folder` on 127.0.0.1, on `port` (0: any free port)."""
     from hexadyn.view.app import Viewer
 
     run = Run(folder)
@@ -71,7 +70,7 @@ def start(folder: str | Path, port: int | None = None) -> RunningViewer:
     return RunningViewer(url=f"http://{HOST}:{server.get_port()}/", viewer=viewer, server=server)
 
 
-def serve(folder: str | Path, port: int | None = None, open_browser: bool = True, echo: Callable[[str], None] = print) -> None:
+def serve(folder: str | Path, port: int = 0, open_browser: bool = True, echo: Callable[[str], None] = print) -> None:
     """Shows `folder` until interrupted: prints the URL and opens it unless `open_browser` is false."""
     running = start(folder, port)
     echo(f"Viewing {folder} at {running.url} (Ctrl-C to stop)")

@@ -28,26 +28,79 @@ pub(crate) use span_index::SpanIndex;
 /// that naming a device (`/dev/zero`) or a huge file fails at once instead of filling memory.
 pub const MAX_INPUT_BYTES: u64 = 64 << 20;
 
-/// The largest terrain mesh file read: 1 GB, a binary PLY of about 40 million triangles.
+/// The largest terrain mesh file read: 1 GB (an ASCII PLY at the bounds of a mesh,
+/// [`crate::physics::terrain::ply::MAX_MESH_TRIANGLES`], with a few extra properties).
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
 
-/// Reads an input file's bytes: a regular file of at most `limit` bytes, so that naming a
-/// device (`/dev/zero`) or a huge file fails at once instead of filling memory. The error is a
-/// one-line reason.
+/// Opens an input file for reading: a regular file of at most `limit` bytes, refused at once
+/// otherwise, with a one-line reason naming what it is (a directory, a named pipe, a device, a
+/// socket) and what is allowed. The type and size are checked before the file is opened, and
+/// again on the open file: the open itself does not block (`O_NONBLOCK`), so a path swapped for
+/// a named pipe in between is refused too instead of waiting for a writer. Returns the file
+/// and its size.
+pub fn open_input(path: impl AsRef<std::path::Path>, limit: u64) -> std::result::Result<(std::fs::File, u64), String> {
+    let path = path.as_ref();
+    let checked = |meta: std::fs::Metadata| -> std::result::Result<u64, String> {
+        let allowed = format!("allowed: a regular file of at most {}", bytes_shown(limit));
+        if !meta.is_file() {
+            return Err(format!("{}; {allowed}", file_kind(&meta.file_type())));
+        }
+        if meta.len() > limit {
+            return Err(format!("{} bytes, too large; {allowed}", meta.len()));
+        }
+        Ok(meta.len())
+    };
+    checked(std::fs::metadata(path).map_err(|e| e.to_string())?)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+    let file = options.open(path).map_err(|e| e.to_string())?;
+    let size = checked(file.metadata().map_err(|e| e.to_string())?)?;
+    Ok((file, size))
+}
+
+/// What a file that is not a regular file is, for [`open_input`]'s refusal.
+fn file_kind(kind: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a named pipe (FIFO), not a regular file";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device, not a regular file";
+        }
+        if kind.is_socket() {
+            return "a socket, not a regular file";
+        }
+    }
+    if kind.is_dir() {
+        "a directory, not a file"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// A size limit in bytes as people read it (`64 MB`, `1 GB`: binary multiples).
+fn bytes_shown(n: u64) -> String {
+    match n {
+        n if n >= 1 << 30 && n % (1 << 30) == 0 => format!("{} GB", n >> 30),
+        n if n >= 1 << 20 && n % (1 << 20) == 0 => format!("{} MB", n >> 20),
+        n => format!("{n} bytes"),
+    }
+}
+
+/// Reads an input file's bytes: a regular file of at most `limit` bytes ([`open_input`]), so
+/// that naming a device (`/dev/zero`), a named pipe or a huge file fails at once instead of
+/// blocking or filling memory. The error is a one-line reason.
 pub fn read_input_bytes(path: impl AsRef<std::path::Path>, limit: u64) -> std::result::Result<Vec<u8>, String> {
     use std::io::Read;
-    let file = std::fs::File::open(path.as_ref()).map_err(|e| e.to_string())?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
-    if !meta.is_file() {
-        return Err(if meta.is_dir() { "a directory, not a file".into() } else { "not a regular file".into() });
-    }
-    if meta.len() > limit {
-        return Err(format!("{} bytes, more than the {limit} allowed for an input file", meta.len()));
-    }
-    let mut bytes = Vec::new();
+    let (file, size) = open_input(path, limit)?;
+    let mut bytes = Vec::with_capacity(size as usize);
     file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| e.to_string())?;
     if bytes.len() as u64 > limit {
-        return Err(format!("more than the {limit} bytes allowed for an input file"));
+        return Err(format!("grew past {} while read; allowed: a regular file of at most {}", bytes_shown(limit), bytes_shown(limit)));
     }
     Ok(bytes)
 }

@@ -89,8 +89,10 @@ impl MeshTerrain {
             }
         }
         let top = t.vertices.iter().map(|v| v[2]).fold(f64::NEG_INFINITY, f64::max) + 1.0;
-        let points = t.vertices.iter().map(|v| PVec::new(v[0], v[1], v[2])).collect();
-        let mesh = TriMesh::with_flags(points, t.faces, TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES).map_err(|_| MeshError::Empty)?;
+        let Triangles { vertices, faces } = t;
+        let points = vertices.iter().map(|v| PVec::new(v[0], v[1], v[2])).collect();
+        drop(vertices); // parry's copy replaces them while it builds the mesh
+        let mesh = TriMesh::with_flags(points, faces, TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES).map_err(|_| MeshError::Empty)?;
         let normals = (0..mesh.num_triangles() as u32).map(|i| mesh.triangle(i).scaled_normal().normalize()).collect();
         Ok(MeshTerrain { mesh, normals, top })
     }

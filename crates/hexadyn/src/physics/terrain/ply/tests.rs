@@ -128,7 +128,9 @@ fn malformed_files_name_the_file_and_the_element() {
     assert!(e.element == "face 0" && e.problem.contains("negative"), "{e}");
     // Truncated: a vertex short of the count.
     let e = error(&format!("{HEADER}0 0 0\n1 0 0\n"));
-    assert!(e.element.starts_with("line"), "{e}");
+    assert_eq!((e.element.as_str(), e.problem.as_str()), ("vertex 2", "line 12: unexpected end of file; the header declares 3 vertex elements"), "{e}");
+    let e = error(&format!("{HEADER}0 0 0\n1 0 0\n0 1\n"));
+    assert!(e.element == "vertex 2" && e.problem.starts_with("line 12: "), "{e}");
     let e = error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n");
     assert!(e.element == "header" && e.problem.contains("`z`"), "{e}");
     let e = error("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n");
@@ -189,4 +191,61 @@ proptest! {
             prop_assert!(!e.element.is_empty() && !e.problem.is_empty(), "{}", message);
         }
     }
+}
+
+/// What ply-rs's whole-file reader finds in `bytes`: the vertices and the fans of the faces,
+/// the reference the streaming reader is held to.
+fn whole_file_reading(bytes: &[u8]) -> Triangles {
+    let ply = ply_rs_bw::parser::Parser::<DefaultElement>::new().read_ply(&mut &bytes[..]).unwrap();
+    let vertices = ply.payload["vertex"].iter().map(|v| ["x", "y", "z"].map(|a| scalar(&v[a]).unwrap())).collect();
+    let mut faces = Vec::new();
+    for f in &ply.payload["face"] {
+        let i = indices(f.get("vertex_indices").or_else(|| f.get("vertex_index")).unwrap()).unwrap();
+        faces.extend((1..i.len() - 1).map(|k| [i[0], i[k], i[k + 1]]));
+    }
+    Triangles { vertices, faces }
+}
+
+#[test]
+fn streaming_reads_what_the_whole_file_reader_reads() {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios/terrains");
+    for entry in std::fs::read_dir(&folder).unwrap() {
+        let path = entry.unwrap().path();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(parse(&bytes, "shipped.ply").unwrap(), whole_file_reading(&bytes), "{}", path.display());
+        assert_eq!(read_terrain(&path).unwrap().triangle_count(), whole_file_reading(&bytes).faces.len(), "{}", path.display());
+    }
+    // Other elements and properties before, between and after, in every encoding.
+    let t = random_triangles(4, 30, 40);
+    for encoding in ENCODINGS {
+        let bytes = handmade(&t, encoding, "double", "uchar", "int");
+        assert_eq!(parse(&bytes, "h.ply").unwrap(), whole_file_reading(&bytes), "{encoding:?}");
+    }
+    let text = "ply\nformat ascii 1.0\nelement camera 2\nproperty float f\nproperty list uchar float k\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement edge 1\nproperty int a\nelement face 1\nproperty uchar flags\nproperty list uchar int vertex_indices\nelement empty 5\nend_header\n1 2 0.5 0.25\n2 0\n0 0 0\n1 0 0\n0 1 0\n7\n1 3 0 1 2\n\n\n\n\n\n";
+    assert_eq!(parse(text.as_bytes(), "e.ply").unwrap(), whole_file_reading(text.as_bytes()));
+}
+
+/// Headers declaring more than the file holds, or than a terrain may have, are refused from
+/// the header, without reading (nor reserving memory for) the elements.
+#[test]
+fn declared_counts_are_checked_before_reading() {
+    let declared = |format: &str, vertices: u64, faces: u64| format!("ply\nformat {format} 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\nproperty float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n");
+    let e = parse(declared("binary_little_endian", 1_000_000_000, 1).as_bytes(), "big.ply").unwrap_err();
+    assert_eq!(e.element, "header", "{e}");
+    assert!(e.problem.starts_with("`element vertex 1000000000` of at least 12 bytes each: the elements up to it need at least 12000000000 bytes, more than the file's 178"), "{e}");
+    let e = parse(declared("ascii", 3, 1 << 40).as_bytes(), "big.ply").unwrap_err();
+    assert!(e.problem.contains("`element face 1099511627776` of at least 2 bytes each"), "{e}");
+    // Held by the file, beyond the bounds.
+    let mut bytes = declared("binary_little_endian", MAX_MESH_VERTICES as u64 + 1, 1).into_bytes();
+    bytes.resize(bytes.len() + 12 * (MAX_MESH_VERTICES + 1) + 13, 0);
+    let e = parse(&bytes, "big.ply").unwrap_err();
+    assert_eq!(e.to_string(), format!("big.ply: header: `element vertex {}`: too many; allowed: at most {MAX_MESH_VERTICES} (hexadyn's bound on a terrain mesh, MAX_MESH_VERTICES)", MAX_MESH_VERTICES + 1));
+}
+
+#[test]
+fn unbounded_lines_are_refused() {
+    let e = parse(format!("ply\nformat ascii 1.0\ncomment {}", "x".repeat(70_000)).as_bytes(), "long.ply").unwrap_err();
+    assert!(e.element == "header" && e.problem.starts_with("no `end_header` in the first 65536 bytes"), "{e}");
+    let e = parse(format!("{HEADER}0 0 0 {}\n", "1 ".repeat(40_000)).as_bytes(), "long.ply").unwrap_err();
+    assert_eq!((e.element.as_str(), e.problem.as_str()), ("vertex 0", "line 10: longer than 65536 bytes; allowed: a line of numbers"), "{e}");
 }
