@@ -486,3 +486,25 @@ fn amru5_counts_are_those_of_the_protocol_page() {
     println!("counts of q_r, q_v, q_h: {ranges:?}");
     assert_eq!(ranges, [(-58_403, 58_402), (219_999, 412_499), (23_333, 256_666)]);
 }
+
+/// The master's controller takes 8 ms after the last packet of a period came at 5 ms: its
+/// command is ready 3 ms after the deadline. The stop names the controller's overrun.
+#[test]
+fn a_slow_controller_is_the_masters_overrun() {
+    use hexadyn::control::{Command, Plant};
+    let s = scenario("stand_six_legs", 1.0);
+    let (clock, emulator, config) = lockstep(&s, Faults::default());
+    let scales = s.model().encoders.map(|e| JointScale::new(Protocol::Motors, e));
+    let mut plant = UdpPlant::<Duty>::connect(&config, Clock::Virtual(clock.clone()), scales, Arc::new(AtomicBool::new(false))).expect("connect");
+    for _ in 0..3 {
+        plant.actuate(&Command::default());
+        plant.wait_period().expect("a period");
+    }
+    clock.advance(Duration::from_millis(8)).expect("the controller's time");
+    let e = plant.wait_period().expect_err("late");
+    let LinkError::Stopped(stop) = &e else { panic!("{e}") };
+    assert_eq!(stop.reason, StopReason::ControllerOverrun { late_s: Duration::from_millis(3).as_secs_f64() });
+    assert!(e.to_string().contains("master overrun in the controller: its command was ready 3.000 ms after the deadline"), "{e}");
+    drop(plant);
+    assert_eq!(emulator.stop().history.last().map(|h| h.setpoints), Some([0; JOINTS]), "the stop");
+}
