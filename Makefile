@@ -77,6 +77,7 @@ bench:
 	$(CARGO) run --release -p hexadyn-benches --bin gait
 	$(CARGO) run --release -p hexadyn-benches --bin walk
 	$(CARGO) run --release -p hexadyn-benches --bin link
+	$(CARGO) run --release -p hexadyn-benches --bin watchdog
 	$(CARGO) run --release -p hexadyn-benches --bin terrain
 	$(CARGO) run --release -p hexadyn-benches --bin terrain_classes
 	$(CARGO) run --release -p hexadyn-benches --bin free_gait_cases

@@ -21,7 +21,7 @@ from conftest import shortened
 
 
 def random_command(rng: random.Random) -> MotorCommands:
-    return MotorCommands(rng.randrange(1 << 16), tuple(rng.randint(-1023, 1023) for _ in range(18)))
+    return MotorCommands(rng.randrange(1 << 16), tuple(rng.randint(-1023, 1023) for _ in range(18)), rng.randrange(1 << 32))
 
 
 def random_reply(rng: random.Random) -> SlaveReply:
@@ -41,8 +41,8 @@ def test_python_mirror_encodes_byte_identically_to_the_engine():
         c = random_command(rng)
         data = c.encode()
         assert len(data) == COMMAND_SIZE
-        assert data == _core.encode_command(c.seq, list(c.duties))
-        assert _core.decode_command(data) == (c.seq, list(c.duties))
+        assert data == _core.encode_command(c.seq, list(c.duties), run=c.run)
+        assert _core.decode_command(data) == (c.seq, c.run, list(c.duties))
         assert MotorCommands.decode(data) == c
         r = random_reply(rng)
         data = r.encode()
@@ -55,14 +55,14 @@ def test_python_mirror_encodes_byte_identically_to_the_engine():
 def test_servo_packets_mirror_the_engine_and_are_not_motor_packets():
     rng = random.Random(7)
     for _ in range(3000):
-        c = ServoCommands(rng.randrange(1 << 16), tuple(rng.randrange(1 << 12) for _ in range(18)))
+        c = ServoCommands(rng.randrange(1 << 16), tuple(rng.randrange(1 << 12) for _ in range(18)), rng.randrange(1 << 32))
         data = c.encode()
-        assert data == _core.encode_command(c.seq, list(c.words), SERVO_VERSION)
-        assert ServoCommands.decode(data) == c and _core.decode_command(data, SERVO_VERSION) == (c.seq, list(c.words))
+        assert data == _core.encode_command(c.seq, list(c.words), SERVO_VERSION, c.run)
+        assert ServoCommands.decode(data) == c and _core.decode_command(data, SERVO_VERSION) == (c.seq, c.run, list(c.words))
         with pytest.raises(PacketError) as e:
             MotorCommands.decode(data)
         assert e.value.kind == "version"
-        with pytest.raises(ValueError, match="protocol version 2, this side speaks 1"):
+        with pytest.raises(ValueError, match="protocol version 4, this side speaks 3"):
             _core.decode_command(data)
         r = SlaveReply(rng.randrange(6), rng.randrange(1 << 16), tuple(rng.randrange(2048) for _ in range(3)), tuple(rng.randint(-25000, 25000) for _ in range(3)), rng.randrange(256))
         data = r.encode(SERVO_VERSION)
@@ -180,3 +180,36 @@ def test_robot_run_errors_are_one_line(tmp_path):
     bad.write_text(LOOPBACK.read_text().replace("period_s = 0.01", "period_s = 0.02"))
     result = CliRunner().invoke(cli, ["robot", "run", "stand_six_legs", "--link", str(bad), "--no-progress"])
     assert result.exit_code == 1 and "timing.period_s" in result.output, result.output
+
+
+@pytest.mark.parametrize("rehearsal, reason", [(["--silent-slave", "3:40"], "missing_replies"), (["--stall-at", "0.5:60"], "master_overrun")])
+def test_every_safety_stop_leaves_its_results_and_reason(tmp_path, rehearsal, reason):
+    # A slave that falls silent, a master that freezes for 60 ms: rehearsed on the emulated slaves
+    # in lock-step; the run ends with one line naming the stop, exit status 1, and the rows up
+    # to the stop are saved with the reason in the summary.
+    scenario = shortened("stand_six_legs", tmp_path, 1.0)
+    out = tmp_path / "robot"
+    result = CliRunner().invoke(cli, ["robot", "run", str(scenario), "--link", "loopback", "--emulated", "--out", str(out), "--no-progress", "--no-plots", *rehearsal])
+    assert result.exit_code == 1, result.output
+    error = result.output.strip().splitlines()[-1]
+    assert error.startswith("Error: safety stop at period") and "Traceback" not in result.output, result.output
+    results = Results.load(out)
+    assert results.summary["safety_stop_reason"] == reason
+    assert results.summary["safety_stop"] == error.removeprefix("Error: ")
+    assert 10 < len(results.timeseries) < 101  # the rows up to the stop
+
+
+def test_an_interrupt_is_a_stop_with_its_reason(tmp_path):
+    scenario = shortened("stand_six_legs", tmp_path, 600.0)
+
+    def interrupt(t: float, duration: float) -> None:
+        raise KeyboardInterrupt
+
+    raw = _core.robot_run(str(scenario), str(LOOPBACK), interrupt, emulated=True)
+    assert raw["stop"].endswith("on request; every motor set to 0 V")
+    assert raw["summary"]["safety_stop_reason"] == "interrupted"
+
+
+def test_faults_are_rehearsed_on_the_emulated_slaves_only():
+    result = CliRunner().invoke(cli, ["robot", "run", "stand_six_legs", "--link", "loopback", "--no-progress", "--silent-slave", "3:40"])
+    assert result.exit_code == 1 and result.output.strip() == "Error: --silent-slave: faults are rehearsed on the emulated slaves only; allowed with --emulated", result.output

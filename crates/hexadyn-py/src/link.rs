@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use hexadyn::link::clock::Clock;
+use hexadyn::link::clock::{Clock, VirtualClock};
 use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
 use hexadyn::link::faults::Faults;
 use hexadyn::link::protocol::{Commands, Duty, Goal, MotorCommands, Protocol, ServoCommands, Setpoint, SlaveReply, COMMAND_SIZE};
@@ -29,41 +29,37 @@ fn config(path: &PathBuf) -> PyResult<LinkConfig> {
     LinkConfig::from_file(path).map_err(value_error)
 }
 
-/// The protocol of version 1 (motor duties) or 2 (servo goals).
+/// The protocol of version 3 (motor duties) or 4 (servo goals).
 fn protocol(version: u8) -> PyResult<Protocol> {
-    match version {
-        1 => Ok(Protocol::Motors),
-        2 => Ok(Protocol::Servos),
-        v => Err(value_error(format!("protocol version {v}: allowed 1 (motor duties) or 2 (servo goals)"))),
-    }
+    Protocol::of_version(version).ok_or_else(|| value_error(format!("protocol version {version}: allowed 3 (motor duties) or 4 (servo goals)")))
 }
 
-fn command_bytes<S: Setpoint>(seq: u16, setpoints: Vec<S>) -> PyResult<[u8; COMMAND_SIZE]> {
+fn command_bytes<S: Setpoint>(seq: u16, run: u32, setpoints: Vec<S>) -> PyResult<[u8; COMMAND_SIZE]> {
     let setpoints: [S; 18] = setpoints.try_into().map_err(|d: Vec<S>| value_error(format!("{} setpoints: allowed 18", d.len())))?;
-    Ok(Commands { seq, setpoints }.encode())
+    Ok(Commands { seq, run, setpoints }.encode())
 }
 
-/// The 36-byte command packet of sequence number `seq` with 18 setpoints: signed duties
-/// (-1023..1023) for `version` 1, servo command words (bits 0-10 the goal register, bit 11 the
-/// torque enable: 0..4095) for version 2.
+/// The 36-byte command packet of sequence number `seq` and run number `run` with 18 setpoints:
+/// signed duties (-1023..1023) for `version` 3, servo command words (bits 0-10 the goal
+/// register, bit 11 the torque enable: 0..4095) for version 4.
 #[pyfunction]
-#[pyo3(signature = (seq, setpoints, version = 1))]
-pub fn encode_command<'py>(py: Python<'py>, seq: u16, setpoints: Vec<i32>, version: u8) -> PyResult<Bound<'py, PyBytes>> {
+#[pyo3(signature = (seq, setpoints, version = 3, run = 0))]
+pub fn encode_command<'py>(py: Python<'py>, seq: u16, setpoints: Vec<i32>, version: u8, run: u32) -> PyResult<Bound<'py, PyBytes>> {
     let bytes = match protocol(version)? {
-        Protocol::Motors => command_bytes(seq, setpoints.iter().map(|&d| i16::try_from(d).ok().and_then(Duty::new).ok_or_else(|| value_error(format!("duty {d}: allowed -1023..1023")))).collect::<PyResult<_>>()?)?,
-        Protocol::Servos => command_bytes(seq, setpoints.iter().map(|&w| u16::try_from(w).ok().filter(|&w| w < 1 << 12).and_then(|w| Goal::from_word(w).ok()).ok_or_else(|| value_error(format!("servo word {w}: allowed 0..4095")))).collect::<PyResult<_>>()?)?,
+        Protocol::Motors => command_bytes(seq, run, setpoints.iter().map(|&d| i16::try_from(d).ok().and_then(Duty::new).ok_or_else(|| value_error(format!("duty {d}: allowed -1023..1023")))).collect::<PyResult<_>>()?)?,
+        Protocol::Servos => command_bytes(seq, run, setpoints.iter().map(|&w| u16::try_from(w).ok().filter(|&w| w < 1 << 12).and_then(|w| Goal::from_word(w).ok()).ok_or_else(|| value_error(format!("servo word {w}: allowed 0..4095")))).collect::<PyResult<_>>()?)?,
     };
     Ok(PyBytes::new(py, &bytes))
 }
 
-/// Decodes a command packet of `version`: (seq, setpoints as in `encode_command`); ValueError
-/// naming why it is rejected.
+/// Decodes a command packet of `version`: (seq, run, setpoints as in `encode_command`);
+/// ValueError naming why it is rejected.
 #[pyfunction]
-#[pyo3(signature = (data, version = 1))]
-pub fn decode_command(data: &[u8], version: u8) -> PyResult<(u16, Vec<i32>)> {
+#[pyo3(signature = (data, version = 3))]
+pub fn decode_command(data: &[u8], version: u8) -> PyResult<(u16, u32, Vec<i32>)> {
     match protocol(version)? {
-        Protocol::Motors => MotorCommands::decode(data).map(|c| (c.seq, c.setpoints.iter().map(|d| i32::from(d.get())).collect())),
-        Protocol::Servos => ServoCommands::decode(data).map(|c| (c.seq, c.setpoints.iter().map(|g| i32::from(g.bits())).collect())),
+        Protocol::Motors => MotorCommands::decode(data).map(|c| (c.seq, c.run, c.setpoints.iter().map(|d| i32::from(d.get())).collect())),
+        Protocol::Servos => ServoCommands::decode(data).map(|c| (c.seq, c.run, c.setpoints.iter().map(|g| i32::from(g.bits())).collect())),
     }
     .map_err(value_error)
 }
@@ -71,7 +67,7 @@ pub fn decode_command(data: &[u8], version: u8) -> PyResult<(u16, Vec<i32>)> {
 /// The 20-byte slave packet of `version` (fields saturated to their ranges as a board's
 /// counters and A/D converters are; `leg` modulo 6).
 #[pyfunction]
-#[pyo3(signature = (leg, seq, counts, currents_ma, supply, version = 1))]
+#[pyo3(signature = (leg, seq, counts, currents_ma, supply, version = 3))]
 pub fn encode_reply<'py>(py: Python<'py>, leg: u8, seq: u16, counts: [i32; 3], currents_ma: [i16; 3], supply: u8, version: u8) -> PyResult<Bound<'py, PyBytes>> {
     Ok(PyBytes::new(py, &SlaveReply { leg, seq, counts, currents_ma, supply }.encode(protocol(version)?)))
 }
@@ -79,7 +75,7 @@ pub fn encode_reply<'py>(py: Python<'py>, leg: u8, seq: u16, counts: [i32; 3], c
 /// Decodes a slave packet of `version`: (leg, seq, counts, currents_ma, supply); ValueError
 /// naming why it is rejected.
 #[pyfunction]
-#[pyo3(signature = (data, version = 1))]
+#[pyo3(signature = (data, version = 3))]
 pub fn decode_reply(data: &[u8], version: u8) -> PyResult<(u8, u16, [i32; 3], [i16; 3], u8)> {
     let r = SlaveReply::decode(data, protocol(version)?).map_err(value_error)?;
     Ok((r.leg, r.seq, r.counts, r.currents_ma, r.supply))
@@ -93,19 +89,40 @@ pub fn decode_reply(data: &[u8], version: u8) -> PyResult<(u8, u16, [i32; 3], [i
 /// the master logged, as (period, message)), "stop" (the safety stop, or None) and, with
 /// `emulated`, "emulator" (the emulator's report, as `robot_emulate` returns it). Ctrl-C
 /// stops the robot at the next period (0 V) and returns what was recorded. `progress(t_s,
-/// duration_s)` is called every 100 ms. Raises ValueError for invalid files, a scenario that
-/// does not fit the link, or slaves that do not answer.
+/// duration_s)` is called every 100 ms. With `emulated`, a rehearsal of faults: `faults` as
+/// `robot_emulate` takes them, and `stall` = (t_s, duration_s): the master freezes `t_s` seconds
+/// after its start (virtual time) for `duration_s`. Raises ValueError for invalid files, a
+/// scenario that does not fit the link, or slaves that do not answer (in time).
 #[pyfunction]
-#[pyo3(signature = (scenario, link, progress = None, overrides = None, emulated = false))]
-pub fn robot_run<'py>(py: Python<'py>, scenario: PathBuf, link: PathBuf, progress: Option<Py<PyAny>>, overrides: Option<Bound<'py, PyDict>>, emulated: bool) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scenario, link, progress = None, overrides = None, emulated = false, faults = None, stall = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn robot_run<'py>(
+    py: Python<'py>,
+    scenario: PathBuf,
+    link: PathBuf,
+    progress: Option<Py<PyAny>>,
+    overrides: Option<Bound<'py, PyDict>>,
+    emulated: bool,
+    faults: Option<Bound<'py, PyDict>>,
+    stall: Option<(f64, f64)>,
+) -> PyResult<Bound<'py, PyDict>> {
     let s = load(&scenario, overrides.as_ref())?;
     let mut config = config(&link)?;
     let (text, robot, robot_source, duration) = (s.text.clone(), s.robot_text.clone(), s.robot_source.clone(), s.duration);
+    if !emulated && (faults.is_some() || stall.is_some()) {
+        return Err(value_error("faults and a master stall are rehearsed on the emulated slaves only: allowed with emulated = True"));
+    }
+    let faults = faults_from(faults.as_ref())?;
     let (clock, emulator) = if emulated {
-        let clock = Clock::virtual_time();
+        let v = VirtualClock::new();
+        if let Some((at, length)) = stall {
+            let seconds = |x: f64, what: &str| if x.is_finite() && x >= 0.0 { Ok(Duration::from_secs_f64(x)) } else { Err(value_error(format!("stall {what} = {x} s: allowed a time >= 0"))) };
+            v.stall(v.now() + seconds(at, "instant")?, seconds(length, "duration")?);
+        }
+        let clock = Clock::Virtual(v);
         config.master.set_port(0);
         config.broadcast.set_port(0);
-        let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { clock: clock.clone(), ..Default::default() })).map_err(value_error)?;
+        let emulator = py.detach(|| Emulator::start(&s, &config, EmulatorOptions { clock: clock.clone(), faults, ..Default::default() })).map_err(value_error)?;
         config.broadcast.set_port(emulator.command_address().port());
         (clock, Some(emulator))
     } else {
@@ -195,8 +212,10 @@ fn report_dict<'py>(py: Python<'py>, report: &EmulatorReport, interrupted: bool)
     let d = PyDict::new(py);
     d.set_item("commands", report.commands)?;
     d.set_item("sent", report.sent)?;
-    d.set_item("ignored", report.ignored)?;
-    d.set_item("rejected", report.rejected.total())?;
+    d.set_item("ignored", report.refused.old)?;
+    d.set_item("rejected", report.refused.rejected.total())?;
+    d.set_item("refused", report.refused.foreign())?;
+    d.set_item("watchdog_trips", report.watchdog.len())?;
     let f = report.faults;
     let fd = PyDict::new(py);
     for (k, v) in [("lost", f.lost), ("silenced", f.silenced), ("duplicated", f.duplicated), ("reordered", f.reordered), ("corrupted", f.corrupted), ("wrong_size", f.wrong_size)] {

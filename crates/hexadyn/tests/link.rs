@@ -8,19 +8,27 @@
 //! every figure below is the same on an idle and on a loaded machine. The real-time timing
 //! (lateness of the deadlines, missed periods) is the `link` benchmark's.
 
+use std::net::{SocketAddr, UdpSocket};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Duration;
 
 use hexadyn::control::Encoder;
 use hexadyn::hexapod::JOINTS;
-use hexadyn::link::clock::Clock;
+use hexadyn::link::clock::{Clock, VirtualClock};
 use hexadyn::link::drive::JointScale;
 use hexadyn::link::emulator::{Emulator, EmulatorOptions, EmulatorReport};
 use hexadyn::link::faults::Faults;
+use hexadyn::link::master::Master;
+use hexadyn::link::protocol::{Duty, MotorCommands, Protocol};
 use hexadyn::link::run::{check, run_robot, RobotRun};
-use hexadyn::link::{LinkConfig, LinkError, StopReason};
-use hexadyn::scenario::{run_scenario, Override, Scenario};
+use hexadyn::link::slave::WATCHDOG;
+use hexadyn::link::{LinkConfig, LinkError, StopReason, UdpPlant};
+use hexadyn::robot::simulation::run;
+use hexadyn::scenario::{run_scenario, Override, Scenario, ScenarioController};
+use rand::{Rng, SeedableRng};
 
 /// The configuration's 3 missing periods in a row before a safety stop.
 const DEFAULT_MISSING: u32 = 3;
@@ -34,19 +42,25 @@ fn scenario(name: &str, duration_s: f64) -> Scenario {
     Scenario::from_file_with(path, &[Override { field: "scenario.duration_s".into(), value: toml::Value::Float(duration_s) }]).expect("shipped scenario")
 }
 
+/// The emulated slaves of `s` on loopback with `faults`, on a new virtual clock, and the
+/// configuration of a master for them (20 periods of virtual time to hear from the six slaves).
+fn lockstep(s: &Scenario, faults: Faults) -> (Arc<VirtualClock>, Emulator, LinkConfig) {
+    let mut config = LinkConfig::loopback(0);
+    config.safety.connect_timeout = Duration::from_millis(200);
+    let clock = VirtualClock::new();
+    let options = EmulatorOptions { faults, history: true, clock: Clock::Virtual(clock.clone()), ..Default::default() };
+    let emulator = Emulator::start(s, &config, options).expect("emulator");
+    config.broadcast.set_port(emulator.command_address().port());
+    (clock, emulator, config)
+}
+
 /// Runs `s` through the master against the emulator on loopback, in lock-step on a virtual
 /// clock; the master stops the robot after `missing_periods` periods without a packet of a
 /// slave.
 fn linked(s: &Scenario, faults: Faults, missing_periods: u32) -> (Result<RobotRun, LinkError>, EmulatorReport) {
-    let mut config = LinkConfig::loopback(0);
+    let (clock, emulator, mut config) = lockstep(s, faults);
     config.safety.missing_periods = missing_periods;
-    // Virtual time: 20 periods to hear from the six slaves.
-    config.safety.connect_timeout = Duration::from_millis(200);
-    let clock = Clock::virtual_time();
-    let options = EmulatorOptions { faults, history: true, clock: clock.clone(), ..Default::default() };
-    let emulator = Emulator::start(s, &config, options).expect("emulator");
-    config.broadcast.set_port(emulator.command_address().port());
-    let run = run_robot(s, &config, clock, |_| ControlFlow::Continue(()));
+    let run = run_robot(s, &config, Clock::Virtual(clock), |_| ControlFlow::Continue(()));
     let report = emulator.stop();
     if let Ok(r) = &run {
         println!("{}: {} periods, {} missed, {} dropped", s.name, r.stats.broadcasts, r.stats.missed_periods, r.stats.dropped());
@@ -172,8 +186,9 @@ fn late_reordered_and_duplicated_packets_are_never_used_as_fresh() {
 
 /// Lateness is virtual: every slave packet delayed 4.9 ms arrives 7.4 + 0.5 l ms after the
 /// broadcast, the last at 9.9 ms, before the deadline at 10 ms, on a loaded machine as on an
-/// idle one; delayed 5.4 ms, slave 5's packets come 0.4 ms after the deadline, stale, every
-/// period: the master never hears from it.
+/// idle one; delayed 5.4 ms, slave 5's packets come 0.4 ms after the deadline, every period:
+/// the start refuses it with that delay after 3 periods (the handshake and 3 more commands,
+/// then the stop), instead of blaming the configuration after its timeout.
 #[test]
 fn a_packet_is_late_in_virtual_time_only() {
     let s = scenario("stand_six_legs", 0.5);
@@ -184,8 +199,24 @@ fn a_packet_is_late_in_virtual_time_only() {
     assert!(run.stats.last_reply.iter().all(|&t| (t - 9.9e-3).abs() < 1e-12), "{:?}", &run.stats.last_reply[..3]);
     let (run, report) = linked(&s, Faults { delay: Duration::from_micros(5400), ..Default::default() }, DEFAULT_MISSING);
     let e = run.expect_err("slave 5 is never on time");
-    assert!(matches!(&e, LinkError::NoAnswer { legs, .. } if legs == &[5]), "{e}");
-    assert!(report.commands >= 20, "20 periods of the connection: {}", report.commands);
+    assert!(matches!(&e, LinkError::LateReplies { legs, delays_ms, .. } if legs == &[5] && (delays_ms[0] - 10.4).abs() < 1e-9), "{e}");
+    assert_eq!(report.commands, 5);
+}
+
+/// `robot emulate --delay-ms 6` against a 10 ms period: slaves 3, 4 and 5 answer 10, 10.5 and
+/// 11 ms after each broadcast, after the period. The start refuses them at once with the true
+/// reason: their delays, 6 ms after their slots, against the period.
+#[test]
+fn slaves_answering_after_the_period_are_refused_with_their_delay() {
+    let s = scenario("stand_six_legs", 0.5);
+    let (run, report) = linked(&s, Faults { delay: Duration::from_millis(6), ..Default::default() }, DEFAULT_MISSING);
+    let e = run.expect_err("three slaves are never on time");
+    let LinkError::LateReplies { legs, delays_ms, beyond_ms, period_ms, .. } = &e else { panic!("{e}") };
+    assert_eq!((legs.as_slice(), delays_ms.as_slice(), *beyond_ms, *period_ms), (&[3, 4, 5][..], &[10.0, 10.5, 11.0][..], 6.0, 10.0));
+    let message = e.to_string();
+    assert!(message.starts_with("loopback: the slave(s) of leg(s) [3, 4, 5] answer 10.00, 10.50, 11.00 ms after the broadcast, up to 6.00 ms after their slots"), "{message}");
+    assert!(message.contains("later than the period of 10 ms (`timing.period_s`)"), "{message}");
+    assert_eq!(report.commands, 5);
 }
 
 #[test]
@@ -249,12 +280,12 @@ fn servo_boards_count_the_packets_of_the_other_kind_and_forged_ones() {
     let master = std::net::UdpSocket::bind("127.0.0.1:0").expect("socket");
     master.set_broadcast(true).expect("broadcast");
     master.set_read_timeout(Some(Duration::from_secs(10))).expect("timeout");
-    let mut forged = ServoCommands::zero(7).encode();
+    let mut forged = ServoCommands::zero(7, 1).encode();
     forged[3] ^= 0x40; // a corrupted goal
-    let mut bad_header = ServoCommands::zero(8).encode();
-    bad_header[11] |= 0x10; // a reserved header nibble set: the CRC no longer matches
+    let mut bad_header = ServoCommands::zero(8, 1).encode();
+    bad_header[11] |= 0x10; // a header nibble changed (the version's): the CRC no longer matches
     let datagrams: Vec<Vec<u8>> = vec![
-        MotorCommands { seq: 1, setpoints: [Duty::new(300).unwrap(); JOINTS] }.encode().to_vec(),
+        MotorCommands { seq: 1, run: 1, setpoints: [Duty::new(300).unwrap(); JOINTS] }.encode().to_vec(),
         forged.to_vec(),
         bad_header.to_vec(),
         vec![0; COMMAND_SIZE - 1],
@@ -263,15 +294,20 @@ fn servo_boards_count_the_packets_of_the_other_kind_and_forged_ones() {
     for d in &datagrams {
         master.send_to(d, to).expect("send");
     }
-    // Then a valid command: its six answers come after the forged ones were handled.
-    let goals = ServoCommands { seq: 9, setpoints: [Goal::position(512).unwrap(); JOINTS] };
-    master.send_to(&goals.encode(), to).expect("send");
+    // Then a valid command, the handshake (every servo's torque off), and a goal command
+    // without a handshake, from another socket: the six answers of the handshake come after the
+    // others were handled.
+    let goals = ServoCommands { seq: 9, run: 1, setpoints: [Goal::position(512).unwrap(); JOINTS] };
+    let other = std::net::UdpSocket::bind("127.0.0.1:0").expect("socket");
+    other.set_broadcast(true).expect("broadcast");
+    other.send_to(&goals.encode(), to).expect("send");
+    master.send_to(&ServoCommands::zero(9, 1).encode(), to).expect("send");
     let mut legs = Vec::new();
     let mut buf = [0u8; 64];
     while legs.len() < 6 {
         let (n, _) = master.recv_from(&mut buf).expect("the six servo packets");
         assert_eq!(n, REPLY_SIZE);
-        assert_eq!(SlaveReply::decode(&buf[..n], Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
+        assert_eq!(SlaveReply::decode(&buf[..n], Protocol::Motors), Err(PacketError::Version { got: 4, expected: 3 }));
         let r = SlaveReply::decode(&buf[..n], Protocol::Servos).expect("a servo packet");
         assert_eq!(r.seq, 9);
         // Standing near the joint zero's middle register.
@@ -279,8 +315,196 @@ fn servo_boards_count_the_packets_of_the_other_kind_and_forged_ones() {
         legs.push(r.leg);
     }
     let report = emulator.stop();
-    assert_eq!(report.commands, 1);
-    assert_eq!((report.rejected.version, report.rejected.checksum, report.rejected.size), (1, 2, 2), "{:?}", report.rejected);
+    assert_eq!((report.commands, report.refused.no_handshake), (1, 1));
+    let rejected = report.refused.rejected;
+    assert_eq!((rejected.version, rejected.checksum, rejected.size), (1, 2, 2), "{rejected:?}");
     legs.sort_unstable();
     assert_eq!(legs, [0, 1, 2, 3, 4, 5]);
+}
+
+/// A master of AMRU5's motors on `config`, its deadlines on `clock`.
+fn bind_master(config: &LinkConfig, clock: &Arc<VirtualClock>) -> Master<Duty> {
+    Master::bind(config, Clock::Virtual(clock.clone())).expect("master socket")
+}
+
+/// The linked `s` driven by its controller from this thread, in lock-step, with
+/// `forged_per_period` CRC-valid commands sent each period from another port to the slaves:
+/// the master's next commands numbered 100 or more ahead with random duties (some the zero
+/// stop), half of them of earlier runs. Returns the emulator's report and the datagrams forged.
+fn drive_with_forger(s: &Scenario, forged_per_period: u32) -> (EmulatorReport, u64) {
+    let (clock, emulator, config) = lockstep(s, Faults::default());
+    let scales = s.model().encoders.map(|e| JointScale::new(Protocol::Motors, e));
+    let mut plant = UdpPlant::<Duty>::connect(&config, Clock::Virtual(clock.clone()), scales, Arc::new(AtomicBool::new(false))).expect("connect");
+    let mut controller = ScenarioController::new(s);
+    let forger = UdpSocket::bind("127.0.0.1:0").expect("forger socket");
+    forger.set_broadcast(true).expect("broadcast");
+    let to = emulator.command_address();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(39);
+    let mut forged = 0u64;
+    run(&mut plant, &mut controller, s.duration, |p, _, _| {
+        for i in 0..forged_per_period {
+            let seq = (p.period_index() as u16).wrapping_add(if i % 2 == 0 { 100 } else { rng.random_range(1..=32767) });
+            let run = if i % 2 == 0 { p.run() } else { p.run().wrapping_sub(rng.random_range(1..1000)) };
+            let duty = if i % 4 == 3 { Duty::ZERO } else { Duty::new(rng.random_range(-1023..=1023)).expect("a duty") };
+            clock.command_sent();
+            forger.send_to(&MotorCommands { seq, run, setpoints: [duty; JOINTS] }.encode(), to).expect("send");
+            forged += 1;
+        }
+    })
+    .expect("linked walk");
+    plant.finish();
+    (emulator.stop(), forged)
+}
+
+/// CRC-valid commands forged from another port, of the master's run or earlier ones, numbered
+/// ahead of the master's (100 ahead: the command that made the old boards ignore the master's
+/// next ones, the 0 V stop included), among the master's own through the loopback interface:
+/// the boards apply none of the 3010 (10 a period); the walk is, period for period, bit for bit
+/// the one without them.
+#[test]
+fn forged_commands_from_another_port_are_never_applied() {
+    let s = scenario("validation_tripod_1_5cm", 3.0);
+    let (clean, none) = drive_with_forger(&s, 0);
+    let (report, forged) = drive_with_forger(&s, 10);
+    assert_eq!((none, forged), (0, 3010));
+    // Besides them, the stop's two repeats, numbered like the stop: old.
+    assert_eq!((report.refused.other_sender, report.refused.old, report.refused.total()), (forged, 2, forged + 2));
+    assert_eq!((report.commands, clean.commands, clean.refused.total()), (302, 302, 2)); // the handshake, 300 periods, the stop
+    assert_eq!(report.history, clean.history);
+    assert_eq!(report.body, clean.body);
+    assert!(report.history.iter().any(|h| h.setpoints.iter().any(|&d| d != 0)), "it walked");
+}
+
+/// A master restarted at the same address and port (a new run): the boards refuse its
+/// handshakes while the old run's watchdog runs, 50 ms after the old master's last command (its
+/// stop), then follow it; the old run's commands are refused from then on.
+#[test]
+fn a_restarted_master_replaces_the_old_one_after_the_watchdog() {
+    let s = scenario("stand_six_legs", 1.0);
+    let (clock, emulator, mut config) = lockstep(&s, Faults::default());
+    let mut first = bind_master(&config, &clock);
+    let SocketAddr::V4(address) = first.local_addr().expect("address") else { panic!("IPv4") };
+    config.master = address;
+    first.start_clock();
+    first.connect().expect("the first master connects");
+    for _ in 0..5 {
+        assert!(first.run_period(&[Duty::ZERO; JOINTS]).expect("period").is_some());
+    }
+    let stopped_at = clock.now();
+    drop(first); // its stop command, then its socket closes
+    let mut second = bind_master(&config, &clock);
+    second.start_clock();
+    second.connect().expect("the restarted master connects");
+    // Handshakes at 10, 20, 30 and 40 ms after the stop are refused; the one at 50 ms is taken.
+    assert_eq!(second.stats.broadcasts, 5);
+    assert!(second.run_period(&[Duty::ZERO; JOINTS]).expect("period").is_some());
+    drop(second);
+    let report = emulator.stop();
+    assert_eq!(report.refused.other_run, 4);
+    let [trip] = report.watchdog[..] else { panic!("{:?}", report.watchdog) };
+    assert_eq!((trip.last, trip.at), (stopped_at, stopped_at + WATCHDOG));
+}
+
+/// kill -9 of the master while the robot walks: no stop command, nothing more. The boards'
+/// watchdog sets every output to 0 V exactly 50 ms after the last command they applied.
+#[test]
+fn after_kill_9_of_the_master_the_outputs_are_at_0_v_50_ms_after_its_last_command() {
+    let s = scenario("validation_tripod_1_5cm", 1.0);
+    let (clock, emulator, config) = lockstep(&s, Faults::default());
+    let scales = s.model().encoders.map(|e| JointScale::new(Protocol::Motors, e));
+    let mut plant = UdpPlant::<Duty>::connect(&config, Clock::Virtual(clock.clone()), scales, Arc::new(AtomicBool::new(false))).expect("connect");
+    run(&mut plant, &mut ScenarioController::new(&s), 0.5, |_, _, _| {}).expect("walk");
+    std::mem::forget(plant); // killed: no destructor runs, no stop is sent
+    clock.advance(Duration::from_millis(100)).expect("time passes");
+    let report = emulator.stop();
+    let last = report.history.last().expect("commands");
+    assert!(last.setpoints.iter().any(|&d| d != 0), "the last command drove the motors: {:?}", last.setpoints);
+    let [trip] = report.watchdog[..] else { panic!("{:?}", report.watchdog) };
+    assert_eq!((trip.last_seq, trip.at - trip.last), (last.seq, WATCHDOG));
+    assert_eq!(report.held, [0; JOINTS]);
+}
+
+/// A master that freezes at a deadline (stopped, descheduled) for 35 ms, then 60 ms: the stop
+/// names the master's own overrun, late by the freeze, and not its slaves, which answered every
+/// command; frozen 60 ms, the boards' watchdog had set the outputs to 0 V 50 ms after its last
+/// command.
+#[test]
+fn a_stalled_master_names_its_own_overrun() {
+    let s = scenario("validation_tripod_1_5cm", 3.0);
+    for (freeze_ms, trips) in [(35, 0), (60, 1)] {
+        let (clock, emulator, config) = lockstep(&s, Faults::default());
+        let freeze = Duration::from_millis(freeze_ms);
+        // The master's deadlines are 10 ms apart from its start: it freezes as it reaches one.
+        clock.stall(clock.now() + Duration::from_secs(1), freeze);
+        let run = run_robot(&s, &config, Clock::Virtual(clock.clone()), |_| ControlFlow::Continue(())).expect("a stop is a result");
+        let report = emulator.stop();
+        let stop = run.stop.clone().expect("a safety stop");
+        assert_eq!(stop.reason, StopReason::MasterOverrun { late_s: freeze.as_secs_f64(), slack_s: 0.005 }, "{freeze_ms} ms");
+        assert!(stop.to_string().contains("master overrun: the master itself reached its deadline"), "{stop}");
+        // The handshake at 10 ms, then 98 periods; the 100th deadline, at 1 s, is the frozen one.
+        assert_eq!((run.stats.missed_periods, run.stats.complete_periods, run.stats.broadcasts), (0, 99, 99));
+        assert_eq!(report.watchdog.len(), trips, "{freeze_ms} ms");
+        if let [trip] = report.watchdog[..] {
+            assert_eq!(trip.at - trip.last, WATCHDOG);
+        }
+        assert_eq!(report.history.last().map(|h| h.setpoints), Some([0; JOINTS]), "the stop");
+        assert_rows_are_fresh(&s, &run, &report);
+    }
+}
+
+/// Oversized and unknown datagrams are logged with their true size (the receive buffer holds any
+/// UDP datagram). The datagrams are in the master's socket before it reads (loopback delivers
+/// at the send); its wait ends at once.
+#[test]
+fn oversized_datagrams_are_logged_with_their_true_size() {
+    let config = LinkConfig::loopback(0);
+    let mut master = Master::<Duty>::bind(&config, Clock::Monotonic).expect("master socket");
+    let to = master.local_addr().expect("address");
+    UdpSocket::bind("127.0.0.10:0").expect("leg 0's address").send_to(&[0u8; 3000], to).expect("send");
+    UdpSocket::bind("127.0.0.1:0").expect("another address").send_to(&[0u8; 65_507], to).expect("send");
+    master.linger(Duration::from_millis(100));
+    let messages: Vec<&str> = master.events.iter().map(|e| e.message.as_str()).collect();
+    assert_eq!(messages.len(), 2, "{messages:?}");
+    assert_eq!(messages[0], "packet of leg 0 rejected: 3000 bytes, expected 20");
+    assert!(messages[1].starts_with("65507 bytes from 127.0.0.1:"), "{messages:?}");
+    assert_eq!((master.stats.rejected.size, master.stats.unknown_source), (1, 1));
+}
+
+/// The encoder counts of AMRU5's joint ranges (Table 5.2, reductions of Table 3.1, 500 counts
+/// per motor revolution), as docs/protocol.md states them.
+#[test]
+fn amru5_counts_are_those_of_the_protocol_page() {
+    let s = scenario("stand_six_legs", 0.1);
+    let encoders = s.model().encoders;
+    let ranges: Vec<(i64, i64)> = (0..3)
+        .map(|k| {
+            let scale = JointScale::new(Protocol::Motors, encoders[k]);
+            let (lower, upper) = s.robot.joint_range(k);
+            (scale.count(lower), scale.count(upper))
+        })
+        .collect();
+    println!("counts of q_r, q_v, q_h: {ranges:?}");
+    assert_eq!(ranges, [(-58_403, 58_402), (219_999, 412_499), (23_333, 256_666)]);
+}
+
+/// The master's controller takes 8 ms after the last packet of a period came at 5 ms: its
+/// command is ready 3 ms after the deadline. The stop names the controller's overrun.
+#[test]
+fn a_slow_controller_is_the_masters_overrun() {
+    use hexadyn::control::{Command, Plant};
+    let s = scenario("stand_six_legs", 1.0);
+    let (clock, emulator, config) = lockstep(&s, Faults::default());
+    let scales = s.model().encoders.map(|e| JointScale::new(Protocol::Motors, e));
+    let mut plant = UdpPlant::<Duty>::connect(&config, Clock::Virtual(clock.clone()), scales, Arc::new(AtomicBool::new(false))).expect("connect");
+    for _ in 0..3 {
+        plant.actuate(&Command::default());
+        plant.wait_period().expect("a period");
+    }
+    clock.advance(Duration::from_millis(8)).expect("the controller's time");
+    let e = plant.wait_period().expect_err("late");
+    let LinkError::Stopped(stop) = &e else { panic!("{e}") };
+    assert_eq!(stop.reason, StopReason::ControllerOverrun { late_s: Duration::from_millis(3).as_secs_f64() });
+    assert!(e.to_string().contains("master overrun in the controller: its command was ready 3.000 ms after the deadline"), "{e}");
+    drop(plant);
+    assert_eq!(emulator.stop().history.last().map(|h| h.setpoints), Some([0; JOINTS]), "the stop");
 }

@@ -6,11 +6,12 @@ size, CRC, version, ranges. For tools and tests: sniffing, replaying, writing a 
 
 - Command packet, 36 bytes: 18 little-endian 16-bit words, word k for motor k = 3 leg + (0:
   q_r, 1: q_v, 2: q_h): bits 0-9 PWM duty, bit 10 direction (1: negative), bit 11 reserved
-  (0), bits 12-15 nibble k of the 9-byte header (sequence number u16, version, CRC-16 u16,
-  4 reserved bytes). CRC-16/IBM-3740 over the 36 bytes with its own nibbles (words 6-9) as 0.
+  (0), bits 12-15 nibble k of the 9-byte header (sequence number u16, version 3, CRC-16 u16,
+  the master's run number u32). CRC-16/IBM-3740 over the 36 bytes with its own nibbles (words
+  6-9) as 0.
 - Slave packet, 20 bytes: version << 4 | leg; sequence number u16; three signed 24-bit encoder
   counts; three i16 currents (mA); supply u8 (0.1 V); CRC-8/AUTOSAR of bytes 0-18.
-- Servo variant, protocol version 2 (position servos): command word bits 0-10 a goal register
+- Servo variant, protocol version 4 (position servos): command word bits 0-10 a goal register
   (0..2047), bit 11 the torque enable; the slave packet's 24-bit fields the present positions
   (0..2047), its currents the servos' present currents.
 """
@@ -20,9 +21,9 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 3
 #: Protocol version of the servo variant.
-SERVO_VERSION = 2
+SERVO_VERSION = 4
 GOAL_MAX = 0x07FF
 COMMAND_SIZE = 36
 REPLY_SIZE = 20
@@ -38,7 +39,7 @@ _DIRECTION_BIT = 1 << 10
 _RESERVED_BIT = 1 << 11
 _TORQUE_BIT = 1 << 11
 _HEADER_BYTES = JOINTS // 2
-_HEADER_SEQ, _HEADER_VERSION, _HEADER_CRC = 0, 2, 3
+_HEADER_SEQ, _HEADER_VERSION, _HEADER_CRC, _HEADER_RUN = 0, 2, 3, 5
 _CRC_WORDS = (6, 7, 8, 9)
 
 __all__ = ["PacketError", "MotorCommands", "ServoCommands", "SlaveReply", "SERVO_VERSION", "crc8_autosar", "crc16_ibm3740", "COMMAND_SIZE", "REPLY_SIZE", "PROTOCOL_VERSION"]
@@ -90,11 +91,12 @@ def _command_crc(data: bytes) -> int:
     return crc16_ibm3740(bytes(b))
 
 
-def _encode_command(seq: int, bits: list[int], version: int) -> bytes:
+def _encode_command(seq: int, run: int, bits: list[int], version: int) -> bytes:
     """The command packet of `version` with the 12 setpoint bits of each word."""
     header = bytearray(_HEADER_BYTES)
     header[_HEADER_SEQ : _HEADER_SEQ + 2] = seq.to_bytes(2, "little")
     header[_HEADER_VERSION] = version
+    header[_HEADER_RUN:] = run.to_bytes(4, "little")
     words = [b | ((header[k // 2] >> (4 * (k % 2))) & 0x0F) << 12 for k, b in enumerate(bits)]
     data = bytearray(struct.pack("<18H", *words))
     crc = _command_crc(bytes(data))
@@ -103,8 +105,8 @@ def _encode_command(seq: int, bits: list[int], version: int) -> bytes:
     return bytes(data)
 
 
-def _decode_command(data: bytes, version: int) -> tuple[int, tuple[int, ...]]:
-    """(seq, the 18 words) of a command packet of `version`, checked as the engine checks it."""
+def _decode_command(data: bytes, version: int) -> tuple[int, int, tuple[int, ...]]:
+    """(seq, run, the 18 words) of a command packet of `version`, checked as the engine checks it."""
     if len(data) != COMMAND_SIZE:
         raise PacketError("size", f"{len(data)} bytes, expected {COMMAND_SIZE}")
     words = struct.unpack("<18H", data)
@@ -117,45 +119,47 @@ def _decode_command(data: bytes, version: int) -> tuple[int, tuple[int, ...]]:
         raise PacketError("checksum", f"CRC {received:#06x} does not match the content ({computed:#06x}): corrupted")
     if header[_HEADER_VERSION] != version:
         raise PacketError("version", f"protocol version {header[_HEADER_VERSION]}, this side speaks {version}")
-    if any(header[_HEADER_CRC + 2 :]):
-        raise PacketError("range", "command header bytes 5-8 (reserved) are not 0")
-    return int.from_bytes(header[_HEADER_SEQ : _HEADER_SEQ + 2], "little"), words
+    return int.from_bytes(header[_HEADER_SEQ : _HEADER_SEQ + 2], "little"), int.from_bytes(header[_HEADER_RUN:], "little"), words
 
 
-def _check_seq(seq: int) -> None:
-    if not 0 <= seq <= 0xFFFF:
-        raise ValueError(f"seq = {seq}: allowed 0..65535")
+def _check_header(seq: int, run: int) -> None:
+    if not 0 <= seq <= 0xFFFF or not 0 <= run <= 0xFFFF_FFFF:
+        raise ValueError(f"seq = {seq}, run = {run}: allowed 0..65535 and 0..4294967295")
 
 
 @dataclass(frozen=True)
 class MotorCommands:
-    """A command packet: the period's sequence number and the 18 signed duties (-1023..1023)."""
+    """A command packet: the period's sequence number, the 18 signed duties (-1023..1023) and the
+    master's run number (the slaves follow the run of their handshake, docs/protocol.md)."""
 
     seq: int
     duties: tuple[int, ...]
+    run: int = 0
 
     def encode(self) -> bytes:
-        _check_seq(self.seq)
+        _check_header(self.seq, self.run)
         if len(self.duties) != JOINTS or any(abs(d) > DUTY_MAX for d in self.duties):
             raise ValueError(f"duties = {self.duties}: allowed 18 integers in -1023..1023")
-        return _encode_command(self.seq, [abs(d) | (_DIRECTION_BIT if d < 0 else 0) for d in self.duties], PROTOCOL_VERSION)
+        return _encode_command(self.seq, self.run, [abs(d) | (_DIRECTION_BIT if d < 0 else 0) for d in self.duties], PROTOCOL_VERSION)
 
     @classmethod
     def decode(cls, data: bytes) -> "MotorCommands":
-        seq, words = _decode_command(data, PROTOCOL_VERSION)
+        seq, run, words = _decode_command(data, PROTOCOL_VERSION)
         if any(w & _RESERVED_BIT for w in words):
             raise PacketError("range", "command word bit 11 (reserved) is set")
         duties = tuple(-(w & DUTY_MAX) if w & _DIRECTION_BIT else w & DUTY_MAX for w in words)
-        return cls(seq, duties)
+        return cls(seq, duties, run)
 
 
 @dataclass(frozen=True)
 class ServoCommands:
-    """A servo command packet (version 2): the sequence number and 18 servo words, bits 0-10 the
-    goal register (0..2047), bit 11 the torque enable (0: torque off, the goal ignored)."""
+    """A servo command packet (version 4): the sequence number, 18 servo words, bits 0-10 the
+    goal register (0..2047), bit 11 the torque enable (0: torque off, the goal ignored), and the
+    master's run number."""
 
     seq: int
     words: tuple[int, ...]
+    run: int = 0
 
     @staticmethod
     def goal(register: int) -> int:
@@ -165,15 +169,15 @@ class ServoCommands:
         return register | _TORQUE_BIT
 
     def encode(self) -> bytes:
-        _check_seq(self.seq)
+        _check_header(self.seq, self.run)
         if len(self.words) != JOINTS or any(not 0 <= w <= 0x0FFF for w in self.words):
             raise ValueError(f"words = {self.words}: allowed 18 integers in 0..4095")
-        return _encode_command(self.seq, list(self.words), SERVO_VERSION)
+        return _encode_command(self.seq, self.run, list(self.words), SERVO_VERSION)
 
     @classmethod
     def decode(cls, data: bytes) -> "ServoCommands":
-        seq, words = _decode_command(data, SERVO_VERSION)
-        return cls(seq, tuple(w & 0x0FFF for w in words))
+        seq, run, words = _decode_command(data, SERVO_VERSION)
+        return cls(seq, tuple(w & 0x0FFF for w in words), run)
 
 
 @dataclass(frozen=True)
@@ -193,7 +197,7 @@ class SlaveReply:
         return self.supply / 10.0
 
     def encode(self, version: int = PROTOCOL_VERSION) -> bytes:
-        """The packet of `version` (1: encoder counts; 2: servo positions 0..2047)."""
+        """The packet of `version` (3: encoder counts; 4: servo positions 0..2047)."""
         low, high = _count_range(version)
         if not 0 <= self.leg < 6 or not 0 <= self.seq <= 0xFFFF or not 0 <= self.supply <= 255:
             raise ValueError(f"leg = {self.leg}, seq = {self.seq}, supply = {self.supply}: allowed 0..5, 0..65535, 0..255")
@@ -234,4 +238,4 @@ def _count_range(version: int) -> tuple[int, int]:
         return COUNT_MIN, COUNT_MAX
     if version == SERVO_VERSION:
         return 0, GOAL_MAX
-    raise ValueError(f"protocol version {version}: allowed 1 (motor duties) or 2 (servo goals)")
+    raise ValueError(f"protocol version {version}: allowed 3 (motor duties) or 4 (servo goals)")

@@ -11,19 +11,25 @@
 //! currents are those at the end of the previous period (the model has no time between the
 //! PWM update and the A/D conversion).
 //!
-//! Commands that do not decode are counted and ignored; a command numbered like the last one
-//! applied (a duplicate) or up to 255 periods before it (reordered) is ignored too. Faults
+//! The boards take the commands by the rules of [`super::slave`]: they follow the master of
+//! their handshake (its address, port and run number), apply its new commands only and count
+//! every other datagram by reason; their watchdog sets every output to 0 V (every servo's torque
+//! off) 50 ms after the last command applied and forgets the master. Faults
 //! ([`super::faults`]) are applied to the outgoing packets.
 //!
 //! On the monotonic clock, two threads: the model thread receives the commands, latches,
 //! schedules the packets and steps the model; the sender thread sends each packet at its time.
 //! With a real-time priority in the configuration, the sender runs at it and the model thread
-//! one below. On a virtual clock ([`EmulatorOptions::clock`]) the model thread is the same and
-//! the packets go to the clock's agenda, sent as the master's virtual time passes their due
-//! time ([`super::virtual_clock`]). The emulator stops on [`Emulator::stop`], or by itself
-//! after `idle_timeout` (wall time) without a command once the first one came.
+//! one below; the model thread wakes for the watchdog when it is due (`ppoll`). On a virtual
+//! clock ([`EmulatorOptions::clock`]) the model thread is the same and the packets go to the
+//! clock's agenda, sent as the master's virtual time passes their due time
+//! ([`super::virtual_clock`]); the watchdog is checked against that time before each datagram,
+//! every 20 ms of wall time and at the end, and fires dated when it was due. The emulator stops
+//! on [`Emulator::stop`], or by itself after `idle_timeout` (wall time) without a command once
+//! the first one came.
 
 use std::net::{SocketAddr, UdpSocket};
+use std::os::fd::AsRawFd;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, Sender};
 use std::sync::Arc;
@@ -31,11 +37,12 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::agenda::{Agenda, Datagram};
-use super::clock::{realtime_thread, sleep_until, Clock, Percentiles};
+use super::clock::{realtime_thread, sleep_until, wait_readable, Clock, Percentiles, Wake};
 use super::config::LinkConfig;
 use super::drive::{Drive, JointScale};
 use super::faults::{FaultCounts, FaultInjector, Faults, Outgoing};
-use super::protocol::{seq_distance, Commands, Duty, Goal, PacketErrorCounts, Protocol, Setpoint, SlaveReply};
+use super::protocol::{Commands, Duty, Goal, Protocol, Setpoint, SlaveReply, RECEIVE_BUFFER};
+use super::slave::{RefusalCounts, Slave, WatchdogTrip};
 use super::virtual_clock::VirtualClock;
 use super::LinkError;
 use crate::control::{Command, Plant};
@@ -45,8 +52,6 @@ use crate::scenario::{settled_robot, Scenario};
 
 /// How often a blocked thread checks whether it must stop.
 const STOP_POLL: Duration = Duration::from_millis(20);
-/// Commands this many periods (or fewer) before the last one applied are reordered duplicates.
-const REORDER_WINDOW: i32 = 255;
 
 /// Options of an emulator run.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -80,10 +85,14 @@ pub struct EmulatedPeriod {
 pub struct EmulatorReport {
     /// Commands applied (each advanced the model by one period).
     pub commands: u64,
-    /// Commands that did not decode, by kind.
-    pub rejected: PacketErrorCounts,
-    /// Duplicated or reordered commands ignored.
-    pub ignored: u64,
+    /// Datagrams of the command port not applied, by reason: not decoded, old, not from the
+    /// boards' master.
+    pub refused: RefusalCounts,
+    /// Each time the watchdog set the outputs to 0 V: on the monotonic clock `at` is when the
+    /// model thread did it, on a virtual clock when it was due.
+    pub watchdog: Vec<WatchdogTrip>,
+    /// The setpoint bits the boards hold at the end (all 0: every output at 0 V).
+    pub held: [u16; JOINTS],
     /// Datagrams sent by the six slaves (faults included).
     pub sent: u64,
     pub faults: FaultCounts,
@@ -235,6 +244,25 @@ impl Outbox {
         }
     }
 
+    /// When the model thread wakes next at the latest: `watchdog` (when due) on the monotonic
+    /// clock; on a virtual clock its time comes from the master, checked every [`STOP_POLL`].
+    fn wake(&self, watchdog: Option<Instant>) -> Instant {
+        let poll = Instant::now() + STOP_POLL;
+        match (self, watchdog) {
+            (Outbox::Sender(_), Some(due)) => poll.min(due),
+            _ => poll,
+        }
+    }
+
+    /// When outputs set for an event `due` then change: now on the monotonic clock (the thread
+    /// woke for it), `due` on a virtual clock.
+    fn fired(&self, due: Instant) -> Instant {
+        match self {
+            Outbox::Sender(_) => Instant::now(),
+            Outbox::Virtual(_) => due,
+        }
+    }
+
     /// The slaves took in a datagram of the command port (a valid command's packets posted).
     fn taken(&self) {
         if let Outbox::Virtual(v) = self {
@@ -259,7 +287,7 @@ fn spawn_model<S: Drive>(robot: SimulatedRobot, initial: [f64; JOINTS], commands
         let realtime = realtime_thread(timing.realtime_priority.map(|p| p.saturating_sub(1).max(1)));
         let scales = robot.robot.model.encoders.map(|e| JointScale::new(S::PROTOCOL, e));
         let applied = Command { goals: robot.robot.model.takes_references().then_some(initial), references: initial, ..Default::default() };
-        let mut e = Slaves::<S> { robot, scales, applied, faults: FaultInjector::new(options.faults.clone()), outbox, report: EmulatorReport { realtime, ..Default::default() }, last_seq: None, timing, history: options.history, step_times: Vec::new(), kind: std::marker::PhantomData };
+        let mut e = Slaves::<S> { robot, scales, applied, faults: FaultInjector::new(options.faults.clone()), outbox, report: EmulatorReport { realtime, ..Default::default() }, slave: Slave::default(), timing, history: options.history, step_times: Vec::new(), kind: std::marker::PhantomData };
         e.serve(&commands, &stop, options.idle_timeout);
         e.outbox.close();
         e.finish()
@@ -276,7 +304,8 @@ struct Slaves<S> {
     faults: FaultInjector,
     outbox: Outbox,
     report: EmulatorReport,
-    last_seq: Option<u16>,
+    /// The boards' rules for the command port.
+    slave: Slave,
     timing: super::config::Timing,
     history: bool,
     /// Wall time of each model period (s).
@@ -286,60 +315,81 @@ struct Slaves<S> {
 
 impl<S: Drive> Slaves<S> {
     fn serve(&mut self, socket: &UdpSocket, stop: &AtomicBool, idle_timeout: Option<Duration>) {
-        let mut buf = [0u8; 2048];
+        let mut buf = vec![0u8; RECEIVE_BUFFER];
         let mut last_command: Option<Instant> = None;
         while !stop.load(Ordering::Relaxed) {
-            let (n, from) = match socket.recv_from(&mut buf) {
+            self.watchdog();
+            let wake = self.outbox.wake(self.slave.watchdog_due());
+            let received = match wait_readable(socket.as_raw_fd(), wake, Duration::ZERO) {
+                Ok(Wake::Readable) => socket.recv_from(&mut buf),
+                Ok(Wake::Deadline) => Err(std::io::ErrorKind::TimedOut.into()),
+                Err(e) => Err(e),
+            };
+            let (n, from) = match received {
                 Ok(r) => r,
                 Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted) => {
                     if let (Some(limit), Some(at)) = (idle_timeout, last_command) {
                         if at.elapsed() >= limit {
-                            return;
+                            break;
                         }
                     }
                     continue;
                 }
                 Err(e) => {
                     self.report.error = Some(format!("receiving the commands: {e}"));
-                    return;
+                    break;
                 }
             };
+            self.watchdog();
             let applied = self.take(&buf[..n], from);
             self.outbox.taken();
             if applied {
                 last_command = Some(Instant::now());
                 if let Err(e) = self.step() {
                     self.report.error = Some(e);
-                    return;
+                    break;
                 }
             }
         }
+        // The time that passed on a virtual clock until the end.
+        self.watchdog();
     }
 
-    /// Takes in a datagram of the command port as the boards do: a valid new command is applied,
-    /// what it latched posted as the six packets. Returns whether it was applied.
+    /// Takes in a datagram of the command port as the boards do ([`Slave::take`]): a new command
+    /// of their master is applied, what it latched posted as the six packets; anything else is
+    /// counted. Returns whether it was applied.
     fn take(&mut self, bytes: &[u8], from: SocketAddr) -> bool {
-        let command = match Commands::<S>::decode(bytes) {
-            Ok(c) => c,
-            Err(e) => {
-                self.report.rejected.count(&e);
-                return false;
+        let now = self.outbox.now();
+        match self.slave.take::<S>(bytes, from, now) {
+            Ok(command) => {
+                self.apply(&command, now, from);
+                true
             }
-        };
-        if let Some(last) = self.last_seq {
-            let d = seq_distance(command.seq, last);
-            if (-REORDER_WINDOW..=0).contains(&d) {
-                self.report.ignored += 1;
-                return false;
-            }
+            Err(_) => false,
         }
-        self.apply(&command, self.outbox.now(), from);
-        true
+    }
+
+    /// Fires the watchdog if it is due: every output at 0 V (every servo's torque off).
+    fn watchdog(&mut self) {
+        if let Some(mut trip) = self.slave.expire(self.outbox.now()) {
+            trip.at = self.outbox.fired(trip.at);
+            self.hold(&[S::default(); JOINTS]);
+            self.report.watchdog.push(trip);
+        }
+    }
+
+    /// The boards' outputs: `setpoints` applied to the model.
+    fn hold(&mut self, setpoints: &[S; JOINTS]) {
+        let supply = self.robot.robot.model.options.supply_voltage;
+        for (k, setpoint) in setpoints.iter().enumerate() {
+            setpoint.apply(k, &self.scales[k], supply, &mut self.applied);
+        }
+        self.robot.actuate(&self.applied);
+        self.report.held = setpoints.map(Setpoint::bits);
     }
 
     /// Latches and posts the six packets, then applies the command to the model.
     fn apply(&mut self, command: &Commands<S>, received: Instant, to: SocketAddr) {
-        self.last_seq = Some(command.seq);
         let state = self.robot.state();
         let q = state.q.as_slice();
         let counts: [i64; JOINTS] = std::array::from_fn(|k| self.scales[k].count(q[6 + k]));
@@ -360,10 +410,7 @@ impl<S: Drive> Slaves<S> {
             let counts = std::array::from_fn(|k| replies[k / 3].counts[k % 3]);
             self.report.history.push(EmulatedPeriod { seq: command.seq, setpoints: command.setpoints.map(Setpoint::bits), counts, body, t: state.t });
         }
-        for (k, setpoint) in command.setpoints.iter().enumerate() {
-            setpoint.apply(k, &self.scales[k], supply, &mut self.applied);
-        }
-        self.robot.actuate(&self.applied);
+        self.hold(&command.setpoints);
         self.report.commands += 1;
     }
 
@@ -380,6 +427,7 @@ impl<S: Drive> Slaves<S> {
         self.report.body = std::array::from_fn(|i| s.q[i]);
         self.report.t = s.t;
         self.report.faults = self.faults.counts;
+        self.report.refused = self.slave.refused;
         self.report.step_time = Percentiles::of(&self.step_times);
         self.report
     }

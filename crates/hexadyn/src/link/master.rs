@@ -12,10 +12,20 @@
 //! current period, for the first time. Everything else is counted, logged and dropped: a stale
 //! or out-of-order packet is never taken as fresh.
 //!
-//! Safety: a slave silent for `safety.missing_periods` periods in a row (3 by default), a
-//! controller overrun (its command not ready at the deadline) or an interrupt broadcasts the
-//! zero command (0 V to every motor, every servo's torque off) and stops the run with a [`SafetyStop`]. Dropping a master that has not
-//! stopped does the same.
+//! Run number: the master draws a random 32-bit run number when it binds and puts it in every
+//! command; the slaves follow the address, port and run of their handshake, the first zero
+//! command they take ([`super::slave`]). The start ([`Master::connect`]) broadcasts the zero
+//! command every period until the six slaves answer one period on time; slaves that answer only
+//! after the period are refused at once with their delays, a run with them could not keep one
+//! period.
+//!
+//! Safety: a slave silent for `safety.missing_periods` periods in a row (3 by default) while the
+//! master kept its deadlines, the master's own overrun — its command not ready at the deadline
+//! (the controller), or the master itself late for a deadline by more than its slaves' replies
+//! leave in the period (stopped, descheduled), which is never blamed on the slaves — or an
+//! interrupt broadcasts the zero command (0 V to every motor, every servo's torque off) and stops
+//! the run with a [`SafetyStop`] naming which. Dropping a master that has not stopped does the
+//! same.
 
 use std::marker::PhantomData;
 use std::net::{SocketAddr, UdpSocket};
@@ -24,7 +34,7 @@ use std::time::{Duration, Instant};
 
 use super::clock::{Clock, Wake};
 use super::config::LinkConfig;
-use super::protocol::{seq_distance, Commands, PacketErrorCounts, Setpoint, SlaveReply, COMMAND_SIZE};
+use super::protocol::{seq_distance, Commands, PacketErrorCounts, Setpoint, SlaveReply, COMMAND_SIZE, RECEIVE_BUFFER};
 use super::LinkError;
 use crate::hexapod::{JOINTS, LEG_COUNT};
 
@@ -32,16 +42,36 @@ use crate::hexapod::{JOINTS, LEG_COUNT};
 const MAX_EVENTS: usize = 200;
 /// How many times the stop command (0 V) is sent, back to back, with the same sequence number.
 const STOP_REPEATS: usize = 3;
+/// How many of the last broadcasts the start remembers, to time the slaves' late answers.
+const SENT_HISTORY: usize = 16;
 
 /// Why the master stopped the robot.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StopReason {
-    /// These slaves' packets were missing for `periods` periods in a row.
+    /// These slaves' packets were missing for `periods` periods in a row, the master on time.
     MissingReplies { legs: Vec<usize>, periods: u32 },
-    /// The controller's command was not ready at its deadline (late by `late_s`).
-    Overrun { late_s: f64 },
+    /// The master's overrun in its controller: the command was ready `late_s` after its deadline.
+    ControllerOverrun { late_s: f64 },
+    /// The master's own overrun: it reached a deadline `late_s` late, more than the `slack_s`
+    /// its slaves' replies leave in the period (its thread did not run in time).
+    MasterOverrun { late_s: f64, slack_s: f64 },
     /// The user asked to stop.
     Interrupted,
+    /// The link failed (a socket error) during the run.
+    LinkFailure { error: String },
+}
+
+impl StopReason {
+    /// A name for the results' summary (`safety_stop_reason`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            StopReason::MissingReplies { .. } => "missing_replies",
+            StopReason::ControllerOverrun { .. } => "controller_overrun",
+            StopReason::MasterOverrun { .. } => "master_overrun",
+            StopReason::Interrupted => "interrupted",
+            StopReason::LinkFailure { .. } => "link_failure",
+        }
+    }
 }
 
 /// A safety stop: every motor was put to 0 V (every servo's torque off) at `period`.
@@ -54,9 +84,17 @@ pub struct SafetyStop {
 impl std::fmt::Display for SafetyStop {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match &self.reason {
-            StopReason::MissingReplies { legs, periods } => write!(f, "safety stop at period {}: no packet from the slave(s) of leg(s) {legs:?} for {periods} periods; every motor set to 0 V", self.period),
-            StopReason::Overrun { late_s } => write!(f, "safety stop at period {}: controller overrun, its command was {:.3} ms late for the deadline; every motor set to 0 V", self.period, late_s * 1e3),
+            StopReason::MissingReplies { legs, periods } => write!(f, "safety stop at period {}: no packet from the slave(s) of leg(s) {legs:?} for {periods} periods, the master on time; every motor set to 0 V", self.period),
+            StopReason::ControllerOverrun { late_s } => write!(f, "safety stop at period {}: master overrun in the controller: its command was ready {:.3} ms after the deadline; every motor set to 0 V", self.period, late_s * 1e3),
+            StopReason::MasterOverrun { late_s, slack_s } => write!(
+                f,
+                "safety stop at period {}: master overrun: the master itself reached its deadline {:.3} ms late (its thread did not run in time), more than the {:.3} ms its slaves' replies leave in the period; not a slave's fault; every motor set to 0 V",
+                self.period,
+                late_s * 1e3,
+                slack_s * 1e3
+            ),
             StopReason::Interrupted => write!(f, "stopped at period {} on request; every motor set to 0 V", self.period),
+            StopReason::LinkFailure { error } => write!(f, "safety stop at period {}: link failure: {error}; the stop command sent, and the boards' watchdog sets every motor to 0 V 50 ms after the last command in any case", self.period),
         }
     }
 }
@@ -105,14 +143,32 @@ impl LinkStats {
     }
 }
 
+/// A slave's answers that came after their period, at the start.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Late {
+    /// Late answers since its last answer on time.
+    count: u32,
+    /// The delay of the last one after its broadcast.
+    delay: Duration,
+}
+
 /// The master's socket, clock and per-period bookkeeping, for the packets of `S`.
 pub struct Master<S: Setpoint> {
     socket: UdpSocket,
     config: LinkConfig,
     clock: Clock,
+    /// The run number in every command.
+    run: u32,
+    /// Receives any datagram whole (its true size in the logs).
+    buffer: Box<[u8]>,
     /// Index of the current period (the last broadcast at a deadline).
     period: u64,
     started: bool,
+    /// At the start: the slaves' late answers, and when the last broadcasts went (by sequence
+    /// number modulo [`SENT_HISTORY`]).
+    connecting: bool,
+    late: [Late; LEG_COUNT],
+    sent: [Instant; SENT_HISTORY],
     next_deadline: Instant,
     broadcast_at: Instant,
     replies: [Option<SlaveReply>; LEG_COUNT],
@@ -137,8 +193,13 @@ impl<S: Setpoint> Master<S> {
             socket,
             config: config.clone(),
             clock,
+            run: rand::random(),
+            buffer: vec![0; RECEIVE_BUFFER].into_boxed_slice(),
             period: 0,
             started: false,
+            connecting: false,
+            late: [Late::default(); LEG_COUNT],
+            sent: [now; SENT_HISTORY],
             next_deadline: now,
             broadcast_at: now,
             replies: [None; LEG_COUNT],
@@ -157,6 +218,19 @@ impl<S: Setpoint> Master<S> {
 
     pub fn config(&self) -> &LinkConfig {
         &self.config
+    }
+
+    /// The run number the master chose: in every command it sends.
+    pub fn run(&self) -> u32 {
+        self.run
+    }
+
+    /// How late the master may reach a deadline: the time its slaves' replies leave in the
+    /// period, Δt − (t_s0 + 5 Δt_s) (5 ms on AMRU5). Later, its slaves cannot answer before the
+    /// next deadline: the master overran.
+    pub fn slack(&self) -> Duration {
+        let t = &self.config.timing;
+        t.period.saturating_sub(t.reply_delay(LEG_COUNT - 1))
     }
 
     /// The first deadline is one period from now.
@@ -192,8 +266,11 @@ impl<S: Setpoint> Master<S> {
     /// missing; stops the robot when a slave has been missing too long.
     pub fn run_period(&mut self, setpoints: &[S; JOINTS]) -> Result<Option<[SlaveReply; LEG_COUNT]>, LinkError> {
         self.wait(self.next_deadline)?;
+        self.check_on_time()?;
         self.broadcast(setpoints)?;
         self.collect()?;
+        // A master that overslept the end of the period cannot blame its slaves for it.
+        self.check_on_time()?;
         let mut silent = Vec::new();
         for leg in 0..LEG_COUNT {
             if self.replies[leg].is_some() {
@@ -225,24 +302,42 @@ impl<S: Setpoint> Master<S> {
         }
     }
 
-    /// The start: broadcasts the zero command every period until the six slaves answer in one period, for
-    /// at most the configured connect timeout (a missing slave is no safety stop yet).
+    /// The start, the slaves' handshake: broadcasts the zero command every period until the six
+    /// slaves answer in one period, for at most the configured connect timeout (a missing slave
+    /// is no safety stop yet). Slaves whose answers come, but only after their period, for
+    /// `safety.missing_periods` periods in a row are refused at once ([`LinkError::LateReplies`]).
     pub fn connect(&mut self) -> Result<[SlaveReply; LEG_COUNT], LinkError> {
         let give_up = self.clock.now() + self.config.safety.connect_timeout;
-        loop {
+        self.connecting = true;
+        let outcome = loop {
             self.wait(self.next_deadline)?;
             self.broadcast(&[S::default(); JOINTS])?;
             self.collect()?;
             if let [Some(a), Some(b), Some(c), Some(d), Some(e), Some(f)] = self.replies {
                 self.stats.complete_periods += 1;
-                return Ok([a, b, c, d, e, f]);
+                break Ok([a, b, c, d, e, f]);
+            }
+            let legs: Vec<usize> = (0..LEG_COUNT).filter(|&l| self.replies[l].is_none()).collect();
+            let late = |limit: u32| legs.iter().all(|&l| self.late[l].count >= limit);
+            if late(self.config.safety.missing_periods) || (self.clock.now() >= give_up && late(1)) {
+                self.stop();
+                break Err(self.late_replies(legs));
             }
             if self.clock.now() >= give_up {
                 self.stop();
-                let legs = (0..LEG_COUNT).filter(|&l| self.replies[l].is_none()).collect();
-                return Err(LinkError::NoAnswer { legs, timeout_s: self.config.safety.connect_timeout.as_secs_f64(), broadcast: self.config.broadcast.to_string() });
+                break Err(LinkError::NoAnswer { legs, timeout_s: self.config.safety.connect_timeout.as_secs_f64(), broadcast: self.config.broadcast.to_string() });
             }
-        }
+        };
+        self.connecting = false;
+        outcome
+    }
+
+    /// The refusal of slaves that answer after their period.
+    fn late_replies(&self, legs: Vec<usize>) -> LinkError {
+        let t = &self.config.timing;
+        let delays_ms = legs.iter().map(|&l| self.late[l].delay.as_secs_f64() * 1e3).collect();
+        let beyond_ms = legs.iter().map(|&l| self.late[l].delay.saturating_sub(t.reply_delay(l)).as_secs_f64() * 1e3).fold(0.0, f64::max);
+        LinkError::LateReplies { legs, delays_ms, beyond_ms, period_ms: t.period.as_secs_f64() * 1e3, origin: self.config.origin.clone() }
     }
 
     /// Stops the robot if the next deadline has passed (the controller overran); call when the
@@ -251,17 +346,32 @@ impl<S: Setpoint> Master<S> {
         let now = self.clock.now();
         if self.started && now > self.next_deadline + self.config.safety.overrun_tolerance {
             let late_s = (now - self.next_deadline).as_secs_f64();
-            return Err(self.safety_stop(StopReason::Overrun { late_s }));
+            return Err(self.safety_stop(StopReason::ControllerOverrun { late_s }));
+        }
+        Ok(())
+    }
+
+    /// Stops the robot if the master itself is later for its next deadline than [`Self::slack`].
+    fn check_on_time(&mut self) -> Result<(), LinkError> {
+        let late = self.clock.now().saturating_duration_since(self.next_deadline);
+        let slack = self.slack();
+        if late > slack {
+            return Err(self.safety_stop(StopReason::MasterOverrun { late_s: late.as_secs_f64(), slack_s: slack.as_secs_f64() }));
         }
         Ok(())
     }
 
     /// Broadcasts the zero command at once and returns the stop as an error.
     pub fn safety_stop(&mut self, reason: StopReason) -> LinkError {
+        LinkError::Stopped(self.stop_for(reason))
+    }
+
+    /// Broadcasts the zero command at once and logs the stop.
+    pub fn stop_for(&mut self, reason: StopReason) -> SafetyStop {
         self.stop();
         let stop = SafetyStop { period: self.period, reason };
         self.event(stop.to_string());
-        LinkError::Stopped(stop)
+        stop
     }
 
     /// Puts every motor to 0 V (every servo's torque off) now: the zero command sent three
@@ -272,7 +382,7 @@ impl<S: Setpoint> Master<S> {
         }
         self.stopped = true;
         let seq = if self.started { self.period.wrapping_add(1) as u16 } else { 0 };
-        let bytes = Commands::<S>::zero(seq).encode();
+        let bytes = Commands::<S>::zero(seq, self.run).encode();
         for _ in 0..STOP_REPEATS {
             match self.socket.send_to(&bytes, self.config.broadcast) {
                 Ok(_) => self.clock.command_sent(),
@@ -310,7 +420,8 @@ impl<S: Setpoint> Master<S> {
         if self.started {
             self.period += 1;
         }
-        let bytes: [u8; COMMAND_SIZE] = Commands { seq: self.period as u16, setpoints: *setpoints }.encode();
+        let seq = self.period as u16;
+        let bytes: [u8; COMMAND_SIZE] = Commands { seq, run: self.run, setpoints: *setpoints }.encode();
         let now = self.clock.now();
         self.socket.send_to(&bytes, self.config.broadcast).map_err(|source| LinkError::Socket { what: "cannot broadcast the commands to", address: self.config.broadcast.to_string(), source })?;
         self.clock.command_sent();
@@ -319,16 +430,20 @@ impl<S: Setpoint> Master<S> {
         self.stats.broadcasts += 1;
         self.started = true;
         self.broadcast_at = now;
+        self.sent[usize::from(seq) % SENT_HISTORY] = now;
         self.next_deadline = deadline + self.config.timing.period;
         self.replies = [None; LEG_COUNT];
         self.arrivals = [Duration::ZERO; LEG_COUNT];
         Ok(())
     }
 
-    /// Collects packets until the six of this period are in or the next deadline comes.
+    /// Collects packets until the six of this period are in or the next deadline comes; at the
+    /// deadline, what came during the last spin of the wait is read too (it came within the
+    /// period).
     fn collect(&mut self) -> Result<(), LinkError> {
         while self.replies.iter().any(Option::is_none) {
             if self.poll(self.next_deadline)? == Wake::Deadline {
+                self.drain();
                 break;
             }
             self.drain();
@@ -338,7 +453,7 @@ impl<S: Setpoint> Master<S> {
 
     /// Reads every datagram waiting on the socket.
     fn drain(&mut self) {
-        let mut buf = [0u8; 2048];
+        let mut buf = std::mem::take(&mut self.buffer);
         loop {
             match self.socket.recv_from(&mut buf) {
                 Ok((n, from)) => {
@@ -346,15 +461,16 @@ impl<S: Setpoint> Master<S> {
                     let at = self.clock.now();
                     self.receive(&buf[..n], from, at);
                 }
-                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return,
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => break,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
                 Err(e) => {
                     // ICMP errors (a slave's port unreachable) surface here on Linux.
                     self.event(format!("receive error: {e}"));
-                    return;
+                    break;
                 }
             }
         }
+        self.buffer = buf;
     }
 
     /// Classifies one datagram; only a fresh packet of this period is kept.
@@ -381,6 +497,11 @@ impl<S: Setpoint> Master<S> {
         if !self.started || d < 0 {
             self.stats.stale += 1;
             self.event(format!("stale packet of leg {leg} (sequence {}, {} period(s) old): dropped", reply.seq, -d));
+            if self.connecting && self.started && -d < SENT_HISTORY as i32 {
+                let late = &mut self.late[leg];
+                late.count += 1;
+                late.delay = at.saturating_duration_since(self.sent[usize::from(reply.seq) % SENT_HISTORY]);
+            }
         } else if d > 0 {
             self.stats.future += 1;
             self.event(format!("packet of leg {leg} numbered {} period(s) ahead: dropped", d));
@@ -389,6 +510,7 @@ impl<S: Setpoint> Master<S> {
         } else {
             self.replies[leg] = Some(reply);
             self.arrivals[leg] = at.saturating_duration_since(self.broadcast_at);
+            self.late[leg].count = 0;
         }
     }
 }

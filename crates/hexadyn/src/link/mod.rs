@@ -9,7 +9,8 @@
 //! - [`config`]: the link configuration file (addresses, period, Fig. 2.21 timing, safety);
 //! - [`clock`]: the clock of the deadline loop, monotonic (precise waits) or virtual (the master
 //!   and the emulator in lock-step, [`virtual_clock`]);
-//! - [`master`]: the deadline loop, packet freshness and the safety stops;
+//! - [`master`]: the deadline loop, the run number, packet freshness and the safety stops;
+//! - [`slave`]: what a slave board does with the commands (its master, the watchdog);
 //! - [`UdpPlant`]: the robot behind the link as a [`crate::control::Plant`];
 //! - [`emulator`]: six slaves answering like the boards, backed by the simulated robot, with
 //!   injectable faults ([`faults`]);
@@ -28,6 +29,7 @@ pub mod faults;
 pub mod master;
 pub mod protocol;
 pub mod run;
+pub mod slave;
 mod udp_plant;
 pub mod virtual_clock;
 
@@ -49,12 +51,23 @@ pub enum LinkError {
     /// The scenario and the link configuration do not fit together.
     #[error("{0}")]
     Mismatch(String),
-    #[error("no answer from the slave(s) of leg(s) {legs:?} within {timeout_s} s of commands broadcast to {broadcast}: check that the boards (or `hexadyn robot emulate`) run with this link configuration")]
+    #[error("no answer from the slave(s) of leg(s) {legs:?} within {timeout_s} s of commands broadcast to {broadcast}: check that the boards (or `hexadyn robot emulate`) run with this link configuration, and that no other master drives them (a board follows one master until 50 ms after its last command)")]
     NoAnswer { legs: Vec<usize>, timeout_s: f64, broadcast: String },
+    /// Slaves answer the start's commands, but only after the period.
+    #[error(
+        "{origin}: the slave(s) of leg(s) {legs:?} answer {} ms after the broadcast, up to {beyond_ms:.2} ms after their slots (t_s0 + leg × Δt_s): later than the period of {period_ms} ms (`timing.period_s`), never before the next deadline; allowed: every slave packet within the period (boards that answer sooner, or a longer period)",
+        milliseconds(.delays_ms)
+    )]
+    LateReplies { legs: Vec<usize>, delays_ms: Vec<f64>, beyond_ms: f64, period_ms: f64, origin: String },
     /// The master stopped the robot (every motor at 0 V).
     #[error("{0}")]
     Stopped(SafetyStop),
     /// The emulator's simulated robot failed.
     #[error("the emulated robot failed: {0}")]
     Emulator(String),
+}
+
+/// Times in ms, two decimals, comma-separated.
+fn milliseconds(values: &[f64]) -> String {
+    values.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", ")
 }

@@ -5,9 +5,11 @@
 //! Python mirror `hexadyn.link.packets` encodes it byte for byte).
 //!
 //! Two kinds of packets share this layout, told apart by their protocol version
-//! ([`Protocol`]): version 1 carries PWM duties to DC motors and encoder counts back (AMRU5,
-//! serial legs under the master's PI); version 2 carries goal positions to position servos and
+//! ([`Protocol`]): version 3 carries PWM duties to DC motors and encoder counts back (AMRU5,
+//! serial legs under the master's PI); version 4 carries goal positions to position servos and
 //! their present positions back (a Dynamixel bus behind each leg's board, beyond the thesis).
+//! Versions 1 and 2 were the same packets without the run number: a board of either side
+//! refuses the other's.
 //! A command word's 12 low bits are a [`Setpoint`] of either kind ([`Duty`], [`Goal`]); the
 //! header, the sequence numbers and the CRCs are the same.
 //!
@@ -20,7 +22,8 @@
 //! H-bridges); bit 10: the direction (1: negative voltage); bit 11: reserved, 0; bits 12-15: a
 //! nibble of the 9-byte header, header byte j = nibble(2j) | nibble(2j+1) << 4: bytes 0-1 the
 //! sequence number (u16), byte 2 the protocol version, bytes 3-4 the CRC-16 (u16), bytes 5-8
-//! reserved, 0. The CRC-16/IBM-3740 (CCITT, poly 0x1021, init 0xFFFF) covers the 36 bytes with
+//! the run number (u32) the master chose at its start, which the slaves check (with the
+//! master's address) against the run of their handshake ([`super::slave`]). The CRC-16/IBM-3740 (CCITT, poly 0x1021, init 0xFFFF) covers the 36 bytes with
 //! the CRC's own four nibbles (bits 12-15 of words 6-9) taken as 0. With the CRC spread over
 //! nibbles, this polynomial at these words still catches every corrupted byte and every error
 //! of at most 3 bits (checked exhaustively over the error syndromes in the tests).
@@ -30,7 +33,7 @@
 //! 500 counts per motor revolution, Section 2.3.2); bytes 12-17 the three motor currents
 //! (i16, mA); byte 18 the supply voltage (u8, 0.1 V); byte 19 the CRC-8/AUTOSAR of bytes 0-18.
 //!
-//! **Servo variant** (version 2): command word bits 0-10 a servo's goal position in its
+//! **Servo variant** (version 4): command word bits 0-10 a servo's goal position in its
 //! position register's counts (0..2047), bit 11 its torque enable; the slave packet's three
 //! 24-bit fields hold the servos' present positions in the same counts (0..2047) and its
 //! currents the servos' present currents.
@@ -66,6 +69,9 @@ pub const COUNT_MIN: i32 = -(1 << 23);
 pub const COUNT_MAX: i32 = (1 << 23) - 1;
 /// Largest servo position (goal or present) in the servo variant: 11 bits.
 pub const GOAL_MAX: u16 = 0x07FF;
+/// Size of the receive buffers: larger than any UDP datagram over IPv4 (at most 65 507 bytes of
+/// payload), so that a datagram is never cut and a rejected one is logged with its true size.
+pub const RECEIVE_BUFFER: usize = 65_536;
 
 const DUTY_MASK: u16 = 0x03FF;
 const DIRECTION_BIT: u16 = 1 << 10;
@@ -80,6 +86,7 @@ const HEADER_BYTES: usize = JOINTS / 2;
 const HEADER_SEQ: usize = 0;
 const HEADER_VERSION: usize = 2;
 const HEADER_CRC: usize = 3;
+const HEADER_RUN: usize = 5;
 /// The command words whose top nibbles hold the CRC-16.
 const CRC_WORDS: [usize; 4] = [2 * HEADER_CRC, 2 * HEADER_CRC + 1, 2 * HEADER_CRC + 2, 2 * HEADER_CRC + 3];
 
@@ -91,17 +98,26 @@ const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 /// as [`PacketError::Version`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Protocol {
-    /// Version 1: PWM duties to DC motors, encoder counts back (AMRU5's boards, Section 2.3.2).
+    /// Version 3: PWM duties to DC motors, encoder counts back (AMRU5's boards, Section 2.3.2).
     Motors,
-    /// Version 2: goal positions to position servos, their present positions back.
+    /// Version 4: goal positions to position servos, their present positions back.
     Servos,
 }
 
 impl Protocol {
     pub const fn version(self) -> u8 {
         match self {
-            Protocol::Motors => 1,
-            Protocol::Servos => 2,
+            Protocol::Motors => 3,
+            Protocol::Servos => 4,
+        }
+    }
+
+    /// The packets of protocol `version`, if this side speaks it.
+    pub const fn of_version(version: u8) -> Option<Protocol> {
+        match version {
+            3 => Some(Protocol::Motors),
+            4 => Some(Protocol::Servos),
+            _ => None,
         }
     }
 
@@ -312,16 +328,19 @@ impl Duty {
     }
 }
 
-/// The content of a command packet: the sequence number of the period and the 18 setpoints.
+/// The content of a command packet: the sequence number of the period, the master's run number
+/// and the 18 setpoints.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Commands<S> {
     pub seq: u16,
+    /// The number the master chose at its start: the slaves follow one run of one master.
+    pub run: u32,
     pub setpoints: [S; JOINTS],
 }
 
-/// A command packet of version 1: 18 motor duties.
+/// A command packet of version 3: 18 motor duties.
 pub type MotorCommands = Commands<Duty>;
-/// A command packet of version 2: 18 servo goals.
+/// A command packet of version 4: 18 servo goals.
 pub type ServoCommands = Commands<Goal>;
 
 /// The CRC of a command packet: over its bytes with the CRC nibbles (words 6-9) cleared.
@@ -341,15 +360,21 @@ fn put_command_crc(bytes: &mut [u8; COMMAND_SIZE], crc: u16) {
 }
 
 impl<S: Setpoint> Commands<S> {
-    /// The stop: every motor at 0 V, or every servo's torque off.
-    pub fn zero(seq: u16) -> Self {
-        Commands { seq, setpoints: [S::default(); JOINTS] }
+    /// The stop: every motor at 0 V, or every servo's torque off (also the handshake).
+    pub fn zero(seq: u16, run: u32) -> Self {
+        Commands { seq, run, setpoints: [S::default(); JOINTS] }
+    }
+
+    /// Whether it is the zero command.
+    pub fn is_zero(&self) -> bool {
+        self.setpoints.iter().all(|s| *s == S::default())
     }
 
     pub fn encode(&self) -> [u8; COMMAND_SIZE] {
         let mut header = [0u8; HEADER_BYTES];
         header[HEADER_SEQ..HEADER_SEQ + 2].copy_from_slice(&self.seq.to_le_bytes());
         header[HEADER_VERSION] = S::PROTOCOL.version();
+        header[HEADER_RUN..].copy_from_slice(&self.run.to_le_bytes());
         let mut packet = CommandPacket { words: [U16::ZERO; JOINTS] };
         for (k, (word, setpoint)) in packet.words.iter_mut().zip(self.setpoints).enumerate() {
             *word = U16::new((setpoint.bits() & SETPOINT_MASK) | u16::from(nibble(&header, k)) << NIBBLE_SHIFT);
@@ -378,14 +403,12 @@ impl<S: Setpoint> Commands<S> {
         if header[HEADER_VERSION] != expected {
             return Err(PacketError::Version { got: header[HEADER_VERSION], expected });
         }
-        if let Some(&b) = header[HEADER_CRC + 2..].iter().find(|&&b| b != 0) {
-            return Err(PacketError::OutOfRange { field: "command header bytes 5-8 (reserved)", value: i64::from(b), allowed: "0" });
-        }
         let mut setpoints = [S::default(); JOINTS];
         for (s, &w) in setpoints.iter_mut().zip(&words) {
             *s = S::from_word(w)?;
         }
-        Ok(Commands { seq: u16::from_le_bytes([header[HEADER_SEQ], header[HEADER_SEQ + 1]]), setpoints })
+        let run = u32::from_le_bytes(std::array::from_fn(|i| header[HEADER_RUN + i]));
+        Ok(Commands { seq: u16::from_le_bytes([header[HEADER_SEQ], header[HEADER_SEQ + 1]]), run, setpoints })
     }
 }
 
@@ -506,11 +529,11 @@ mod tests {
     }
 
     fn any_commands() -> impl Strategy<Value = MotorCommands> {
-        (any::<u16>(), proptest::array::uniform18(any_duty())).prop_map(|(seq, setpoints)| MotorCommands { seq, setpoints })
+        (any::<u16>(), any::<u32>(), proptest::array::uniform18(any_duty())).prop_map(|(seq, run, setpoints)| MotorCommands { seq, run, setpoints })
     }
 
     fn any_servo_commands() -> impl Strategy<Value = ServoCommands> {
-        (any::<u16>(), proptest::array::uniform18((0u16..=SETPOINT_MASK).prop_map(Goal))).prop_map(|(seq, setpoints)| ServoCommands { seq, setpoints })
+        (any::<u16>(), any::<u32>(), proptest::array::uniform18((0u16..=SETPOINT_MASK).prop_map(Goal))).prop_map(|(seq, run, setpoints)| ServoCommands { seq, run, setpoints })
     }
 
     fn any_reply_of(protocol: Protocol) -> impl Strategy<Value = SlaveReply> {
@@ -542,12 +565,12 @@ mod tests {
         fn servo_packets_round_trip_and_are_not_motor_packets(c in any_servo_commands(), r in any_reply_of(Protocol::Servos)) {
             let bytes = c.encode();
             prop_assert_eq!(ServoCommands::decode(&bytes), Ok(c));
-            prop_assert_eq!(MotorCommands::decode(&bytes), Err(PacketError::Version { got: 2, expected: 1 }));
+            prop_assert_eq!(MotorCommands::decode(&bytes), Err(PacketError::Version { got: 4, expected: 3 }));
             let reply = r.encode(Protocol::Servos);
             prop_assert_eq!(SlaveReply::decode(&reply, Protocol::Servos), Ok(r));
-            prop_assert_eq!(SlaveReply::decode(&reply, Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
-            let motor = MotorCommands { seq: c.seq, setpoints: [Duty::ZERO; JOINTS] }.encode();
-            prop_assert_eq!(ServoCommands::decode(&motor), Err(PacketError::Version { got: 1, expected: 2 }));
+            prop_assert_eq!(SlaveReply::decode(&reply, Protocol::Motors), Err(PacketError::Version { got: 4, expected: 3 }));
+            let motor = MotorCommands::zero(c.seq, c.run).encode();
+            prop_assert_eq!(ServoCommands::decode(&motor), Err(PacketError::Version { got: 3, expected: 4 }));
         }
 
         /// Any one byte of a valid packet changed is caught by the CRC-8 (a burst of at most 8
@@ -618,7 +641,7 @@ mod tests {
             }
             // Half of the version nibbles forged to one of the two kinds.
             if len == REPLY_SIZE && n % 4 == 3 {
-                bytes[0] = (1 + (n / 4 % 2) as u8) << 4 | (bytes[0] & 0x0F);
+                bytes[0] = (Protocol::Motors.version() + (n / 4 % 2) as u8) << 4 | (bytes[0] & 0x0F);
                 bytes[REPLY_SIZE - 1] = CRC8.checksum(&bytes[..REPLY_SIZE - 1]);
             }
             let results = [
@@ -646,7 +669,7 @@ mod tests {
     /// positions) and every error of 1, 2 or 3 bits has a non-zero syndrome.
     #[test]
     fn command_crc_catches_every_byte_and_three_bit_error() {
-        let clean = MotorCommands::zero(0).encode();
+        let clean = MotorCommands::zero(0, 0).encode();
         let syndrome = |flip: &dyn Fn(&mut [u8; COMMAND_SIZE])| {
             let mut b = clean;
             flip(&mut b);
@@ -674,32 +697,34 @@ mod tests {
 
     #[test]
     fn known_layout() {
-        // Seq 0x1234, version 1: header 34 12 01 crc 00..; duty +5 on motor 0, -1023 on motor 17.
+        // Seq 0x1234, version 3, run 0x89ABCDEF: header 34 12 03 crc crc ef cd ab 89; duty +5
+        // on motor 0, -1023 on motor 17.
         let mut duties = [Duty::ZERO; JOINTS];
         duties[0] = Duty(5);
         duties[17] = Duty(-1023);
-        let b = MotorCommands { seq: 0x1234, setpoints: duties }.encode();
+        let b = MotorCommands { seq: 0x1234, run: 0x89AB_CDEF, setpoints: duties }.encode();
+        let nibbles: Vec<u16> = (0..JOINTS).map(|k| u16::from_le_bytes([b[2 * k], b[2 * k + 1]]) >> 12).collect();
         assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x4005); // nibble 0 = 4 (seq low nibble), duty 5
-        assert_eq!(u16::from_le_bytes([b[2], b[3]]) >> 12, 0x3);
-        assert_eq!(u16::from_le_bytes([b[4], b[5]]) >> 12, 0x2);
-        assert_eq!(u16::from_le_bytes([b[6], b[7]]) >> 12, 0x1);
-        assert_eq!(u16::from_le_bytes([b[8], b[9]]) >> 12, 0x1); // version 1, low nibble
-        assert_eq!(u16::from_le_bytes([b[34], b[35]]), 0x07FF); // direction + 1023
+        assert_eq!(nibbles[1..6], [0x3, 0x2, 0x1, 0x3, 0x0]); // seq, version 3
+        assert_eq!(nibbles[10..], [0xF, 0xE, 0xD, 0xC, 0xB, 0xA, 0x9, 0x8]); // run, low nibble first
+        assert_eq!(u16::from_le_bytes([b[34], b[35]]) & 0x0FFF, 0x07FF); // direction + 1023
+        println!("motor command: {b:02x?}");
         let r = SlaveReply { leg: 3, seq: 0x1234, counts: [-1, 0x123456, 0], currents_ma: [-2, 0, 25_000], supply: 120 }.encode(Protocol::Motors);
-        assert_eq!(&r[..12], &[0x13, 0x34, 0x12, 0xFF, 0xFF, 0xFF, 0x56, 0x34, 0x12, 0, 0, 0]);
+        assert_eq!(&r[..12], &[0x33, 0x34, 0x12, 0xFF, 0xFF, 0xFF, 0x56, 0x34, 0x12, 0, 0, 0]);
+        println!("motor reply: {r:02x?}");
         assert_eq!(&r[12..19], &[0xFE, 0xFF, 0, 0, 0xA8, 0x61, 120]);
         // The servo variant (docs/protocol.md): goal 512 with the torque on at servo 0, torque
         // off at servo 17; leg 3's present positions 0, 512, 2047.
         let mut goals = [Goal::OFF; JOINTS];
         goals[0] = Goal::position(512).unwrap();
-        let b = ServoCommands { seq: 0x1234, setpoints: goals }.encode();
+        let b = ServoCommands { seq: 0x1234, run: 0x89AB_CDEF, setpoints: goals }.encode();
         assert_eq!(u16::from_le_bytes([b[0], b[1]]), 0x4A00); // nibble 4, torque on, 512
-        assert_eq!(u16::from_le_bytes([b[8], b[9]]) >> 12, 0x2); // version 2
+        assert_eq!(u16::from_le_bytes([b[8], b[9]]) >> 12, 0x4); // version 4
         assert_eq!(u16::from_le_bytes([b[34], b[35]]) & 0x0FFF, 0);
         assert_eq!(Goal::position(2048), None);
         assert_eq!((goals[0].register(), Goal::OFF.register()), (Some(512), None));
         let r = SlaveReply { leg: 3, seq: 0x1234, counts: [0, 512, 2047], currents_ma: [-2, 0, 1500], supply: 111 }.encode(Protocol::Servos);
-        assert_eq!(&r[..12], &[0x23, 0x34, 0x12, 0, 0, 0, 0, 0x02, 0, 0xFF, 0x07, 0]);
+        assert_eq!(&r[..12], &[0x43, 0x34, 0x12, 0, 0, 0, 0, 0x02, 0, 0xFF, 0x07, 0]);
         println!("servo command: {b:02x?}\nservo reply: {r:02x?}");
         // The catalogue check values of CRC-8/AUTOSAR and CRC-16/IBM-3740.
         assert_eq!(CRC8.checksum(b"123456789"), 0xDF);
@@ -725,21 +750,28 @@ mod tests {
     fn rejections_name_their_cause() {
         assert_eq!(SlaveReply::decode(&[0; 19], Protocol::Motors), Err(PacketError::Size { expected: 20, got: 19 }));
         let mut b = SlaveReply { leg: 0, seq: 1, counts: [0; 3], currents_ma: [0; 3], supply: 120 }.encode(Protocol::Motors);
-        b[0] = 0x26; // version 2, leg 6
+        b[0] = 0x46; // version 4, leg 6
         b[19] = CRC8.checksum(&b[..19]);
-        assert_eq!(SlaveReply::decode(&b, Protocol::Motors), Err(PacketError::Version { got: 2, expected: 1 }));
+        assert_eq!(SlaveReply::decode(&b, Protocol::Motors), Err(PacketError::Version { got: 4, expected: 3 }));
         assert!(matches!(SlaveReply::decode(&b, Protocol::Servos), Err(PacketError::OutOfRange { field: "leg", value: 6, .. })));
-        b[0] = 0x16;
+        b[0] = 0x36;
         b[19] = CRC8.checksum(&b[..19]);
         assert!(matches!(SlaveReply::decode(&b, Protocol::Motors), Err(PacketError::OutOfRange { field: "leg", value: 6, .. })));
         // A servo position beyond 11 bits (a forged or wrong-kind packet).
-        b[0] = 0x20;
+        b[0] = 0x40;
         b[3] = 0xFF; // -1 in the first 24-bit field
         b[4] = 0xFF;
         b[5] = 0xFF;
         b[19] = CRC8.checksum(&b[..19]);
         assert!(matches!(SlaveReply::decode(&b, Protocol::Servos), Err(PacketError::OutOfRange { field: "position count", value: -1, .. })));
-        assert_eq!(PacketError::Version { got: 2, expected: 1 }.to_string(), "protocol version 2, this side speaks 1");
+        assert_eq!(PacketError::Version { got: 4, expected: 3 }.to_string(), "protocol version 4, this side speaks 3");
+        // The packets of versions 1 and 2 (before the run number) are refused.
+        let mut old = MotorCommands::zero(7, 0).encode();
+        old[9] = (old[9] & 0x0F) | 1 << 4; // version nibble 1
+        let crc = command_crc(&old);
+        put_command_crc(&mut old, crc);
+        assert_eq!(MotorCommands::decode(&old), Err(PacketError::Version { got: 1, expected: 3 }));
+        assert_eq!((Protocol::of_version(3), Protocol::of_version(4), Protocol::of_version(2)), (Some(Protocol::Motors), Some(Protocol::Servos), None));
         assert_eq!(seq_distance(2, 65534), 4);
         assert_eq!(seq_distance(65534, 2), -4);
     }

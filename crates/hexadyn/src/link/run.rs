@@ -29,7 +29,9 @@
 //! The run makes as many controller updates as the simulation of the scenario; each missed
 //! period (no update) adds a period, so the last row's t exceeds the duration by the missed
 //! periods. A safety stop ends the run early with the rows up to it; the summary says why
-//! (`safety_stop`).
+//! (`safety_stop`, its message, and `safety_stop_reason`: `missing_replies`,
+//! `controller_overrun`, `master_overrun`, `interrupted` or `link_failure`, a socket error
+//! during the run; `none` without a stop).
 
 use std::borrow::Cow;
 use std::ops::ControlFlow;
@@ -211,7 +213,7 @@ fn master_thread<S: Drive>(s: &Scenario, config: &LinkConfig, clock: Clock, peri
     let stop = match outcome {
         Ok(_) => None,
         Err(LinkError::Stopped(stop)) => Some(stop),
-        Err(e) => return Err(e),
+        Err(e) => Some(plant.fail(&e)),
     };
     let (mut stats, events, controller_time) = plant.finish();
     stats.realtime = realtime;
@@ -342,6 +344,7 @@ impl Row {
             ("control_periods", Count(rows.saturating_sub(1))),
             ("rows", Count(rows)),
             ("safety_stop", Text(stop.map_or_else(|| "none".to_string(), ToString::to_string))),
+            ("safety_stop_reason", Text(stop.map_or("none", |s| s.reason.kind()).to_string())),
             ("realtime", Flag(stats.realtime)),
             ("broadcasts", Count(stats.broadcasts)),
             ("missed_periods", Count(stats.missed_periods)),

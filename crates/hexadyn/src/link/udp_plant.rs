@@ -23,7 +23,7 @@ use std::time::Instant;
 use super::clock::Clock;
 use super::config::LinkConfig;
 use super::drive::{Drive, JointScale};
-use super::master::{LinkEvent, LinkStats, Master, StopReason};
+use super::master::{LinkEvent, LinkStats, Master, SafetyStop, StopReason};
 use super::protocol::SlaveReply;
 use super::LinkError;
 use crate::control::{Command, Measurements, Plant};
@@ -130,6 +130,16 @@ impl<S: Drive> UdpPlant<S> {
     /// registers; NaN with motors).
     pub fn goals(&self, command: &Command) -> [f64; JOINTS] {
         std::array::from_fn(|k| S::commanded(command, k, &self.scales[k], self.replies[k / 3].supply_voltage()).goal(&self.scales[k]))
+    }
+
+    /// The run number in the master's commands.
+    pub fn run(&self) -> u32 {
+        self.master.run()
+    }
+
+    /// The link failed with `error` during the run: every motor to 0 V, and the stop that says so.
+    pub fn fail(&mut self, error: &LinkError) -> SafetyStop {
+        self.master.stop_for(StopReason::LinkFailure { error: error.to_string() })
     }
 
     pub fn stats(&self) -> &LinkStats {

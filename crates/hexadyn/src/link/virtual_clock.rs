@@ -12,6 +12,11 @@
 //! exactly as a packet arriving after it on the robot. Neither side waits on the wall clock
 //! except for a datagram already sent on loopback, or a command already broadcast, to arrive:
 //! if one does not within [`DELIVERY_LIMIT`], the wait fails.
+//!
+//! A test can make the master late: [`VirtualClock::stall`] freezes it at an instant for a
+//! while, wherever it is then (a stopped or descheduled process), and [`VirtualClock::advance`]
+//! lets time pass without it (a master that died). Meanwhile the slaves' packets are sent when
+//! due and wait in the master's socket; the emulated slaves see the time and their watchdog.
 
 use std::io;
 use std::net::UdpSocket;
@@ -48,12 +53,14 @@ struct State {
     sent: u64,
     /// The first slave datagram that could not be sent.
     error: Option<String>,
+    /// The master freezes at this instant for this long (once).
+    stall: Option<(Instant, Duration)>,
 }
 
 impl VirtualClock {
     /// A clock at the current instant, standing still until a master waits on it.
     pub fn new() -> Arc<Self> {
-        let state = State { now: Instant::now(), commands_sent: 0, commands_taken: 0, slaves: None, agenda: Agenda::default(), in_flight: 0, sent: 0, error: None };
+        let state = State { now: Instant::now(), commands_sent: 0, commands_taken: 0, slaves: None, agenda: Agenda::default(), in_flight: 0, sent: 0, error: None, stall: None };
         Arc::new(VirtualClock { state: Mutex::new(state), changed: Condvar::new() })
     }
 
@@ -76,9 +83,36 @@ impl VirtualClock {
         self.changed.notify_all();
     }
 
-    /// The master sent a command datagram.
-    pub(crate) fn command_sent(&self) {
+    /// A datagram was sent to the slaves' command port: by the master, or by a test posing as
+    /// another sender (counted before it is sent). The master's next wait lets the slaves take it
+    /// first.
+    pub fn command_sent(&self) {
         self.lock().commands_sent += 1;
+    }
+
+    /// The master freezes at `at` for `duration`, wherever it is then (waiting for its deadline,
+    /// collecting the slaves' packets), as a stopped or descheduled process: at its first wait
+    /// that reaches `at`, time jumps by `duration`.
+    pub fn stall(&self, at: Instant, duration: Duration) {
+        self.lock().stall = Some((at, duration));
+    }
+
+    /// Lets `duration` pass without the master (a master that died): once the slaves took every
+    /// command sent, the packets due meanwhile are sent (they wait in the master's socket).
+    pub fn advance(&self, duration: Duration) -> io::Result<()> {
+        let mut s = self.taken()?;
+        let until = s.now + duration;
+        s.pass(until);
+        Ok(())
+    }
+
+    /// The state once the emulated slaves took every command sent (or stopped listening).
+    fn taken(&self) -> io::Result<MutexGuard<'_, State>> {
+        let (s, waited) = self.changed.wait_timeout_while(self.lock(), DELIVERY_LIMIT, |s| s.slaves.is_some() && s.commands_taken < s.commands_sent).unwrap_or_else(PoisonError::into_inner);
+        if waited.timed_out() {
+            return Err(io::Error::new(io::ErrorKind::TimedOut, format!("the emulated slaves took no command within {} s of its broadcast", DELIVERY_LIMIT.as_secs())));
+        }
+        Ok(s)
     }
 
     /// The emulated slaves took in a datagram, after scheduling their answers.
@@ -107,13 +141,8 @@ impl VirtualClock {
     /// The master's wait: until a slave datagram is readable on `fd`, or virtual time reaches
     /// `deadline`.
     pub(crate) fn wait_readable(&self, fd: RawFd, deadline: Instant) -> io::Result<Wake> {
-        let mut s = self.lock();
         loop {
-            let (guard, waited) = self.changed.wait_timeout_while(s, DELIVERY_LIMIT, |s| s.slaves.is_some() && s.commands_taken < s.commands_sent).unwrap_or_else(PoisonError::into_inner);
-            s = guard;
-            if waited.timed_out() {
-                return Err(io::Error::new(io::ErrorKind::TimedOut, format!("the emulated slaves took no command within {} s of its broadcast", DELIVERY_LIMIT.as_secs())));
-            }
+            let mut s = self.taken()?;
             if s.in_flight > 0 {
                 drop(s);
                 return match wait_readable(fd, Instant::now() + DELIVERY_LIMIT, Duration::ZERO)? {
@@ -121,12 +150,19 @@ impl VirtualClock {
                     Wake::Deadline => Err(io::Error::new(io::ErrorKind::TimedOut, format!("a slave packet sent on loopback did not arrive within {} s", DELIVERY_LIMIT.as_secs()))),
                 };
             }
-            match s.agenda.next_due() {
-                Some(due) if due < deadline => {
+            let next = s.agenda.next_due().filter(|&due| due < deadline);
+            if let Some((at, duration)) = s.stall.filter(|&(at, _)| at <= next.unwrap_or(deadline)) {
+                s.stall = None;
+                let until = s.now.max(at) + duration;
+                s.pass(until);
+                continue;
+            }
+            match next {
+                Some(due) => {
                     s.now = s.now.max(due);
                     s.send_due();
                 }
-                _ => {
+                None => {
                     s.now = s.now.max(deadline);
                     return Ok(Wake::Deadline);
                 }
@@ -136,6 +172,15 @@ impl VirtualClock {
 }
 
 impl State {
+    /// Time passes until `until`: the datagrams due meanwhile are sent at their times.
+    fn pass(&mut self, until: Instant) {
+        while let Some(due) = self.agenda.next_due().filter(|&due| due <= until) {
+            self.now = self.now.max(due);
+            self.send_due();
+        }
+        self.now = self.now.max(until);
+    }
+
     /// Sends every datagram due now from the slaves' sockets.
     fn send_due(&mut self) {
         while let Some(d) = self.agenda.pop_due(self.now) {
@@ -185,5 +230,18 @@ mod tests {
         // The packet due at 12 ms is late for the deadline at 10 ms: it comes in the next wait.
         assert_eq!(clock.wait_readable(fd, ms(20)).expect("wait"), Wake::Readable);
         assert_eq!((clock.now(), clock.sent()), (ms(12), (3, None)));
+        let _ = master.recv_from(&mut buf).expect("the packet due at 12 ms");
+        clock.datagram_received();
+        // Frozen at 22 ms for 10 ms while it waits for its deadline at 30 ms: the packet due at
+        // 25 ms waits in its socket, and the master wakes at 32 ms, late.
+        clock.schedule(Datagram { due: ms(25), leg: 1, to, bytes: vec![1] });
+        clock.stall(ms(22), Duration::from_millis(10));
+        assert_eq!(clock.wait_readable(fd, ms(30)).expect("wait"), Wake::Readable);
+        assert_eq!((clock.now(), clock.sent()), (ms(32), (4, None)));
+        let _ = master.recv_from(&mut buf).expect("the packet due at 25 ms");
+        clock.datagram_received();
+        assert_eq!(clock.wait_readable(fd, ms(30)).expect("wait"), Wake::Deadline);
+        clock.advance(Duration::from_millis(3)).expect("advance");
+        assert_eq!(clock.now(), ms(35));
     }
 }
