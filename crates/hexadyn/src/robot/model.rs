@@ -392,9 +392,11 @@ impl Robot {
         // Ground contact at the feet (Eq. 3.72-3.73).
         for (leg, foot) in feet.iter().enumerate() {
             let mut c = m.options.ground.force_at(foot.proximity, &foot.velocity);
-            // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v.
+            // The rig's load: a constant vertical force, no change to ∂F/∂p, ∂F/∂v; the feet
+            // work against it as against the ground (the energy balance's contact work).
             c.force.z += m.options.foot_load[leg];
             c.normal_force += m.options.foot_load[leg];
+            c.absorbed_power -= m.options.foot_load[leg] * foot.velocity.z;
             out.contact[leg] = c;
             out.foot[leg] = foot.position;
         }

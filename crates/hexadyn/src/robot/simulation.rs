@@ -26,8 +26,9 @@ pub struct EnergyAccount {
     pub friction_work: [f64; JOINTS],
     /// ∫ τ_m q' dt per joint: mechanical work of the motor on its joint.
     pub motor_work: [f64; JOINTS],
-    /// ∫ −F·v dt per foot: work done by the feet on the ground (including the elastic energy
-    /// stored in the ground, see `contact_energy`).
+    /// ∫ −F·v dt per foot: work done by the feet on the ground and on the stand's loads
+    /// (`model.foot_load_kg`), including the elastic energy stored in the ground, see
+    /// `contact_energy`.
     pub contact_work: [f64; 6],
     /// Stored energies at the current state: kinetic, potential (gravity), bristles ½ σ0 z²,
     /// ground ∫ K δ^p_K dδ, inductances ½ L i².
