@@ -277,7 +277,7 @@ def test_compare_reads_the_velocity_through_the_engine(tmp_path: Path):
 
 def test_compare_friction_with_one_velocity_skips_the_fit(tmp_path: Path):
     path = shortened("validation_tripod_1_5cm", tmp_path, 0.5)
-    result = invoke("compare-friction", str(path), "--velocities", "1.5", "--models", "none", "--out", str(tmp_path / "cmp"), "--no-progress", "--jobs", "1")
+    result = invoke("compare-friction", str(path), "--velocities", "1.5", "--models", "none", "--out", str(tmp_path / "cmp"), "--no-progress", "--workers", "1")
     assert result.exit_code == 0, result.output
     assert "averaged power of the q_r actuators" in result.output and "skipped: it needs at least two velocities" in result.output
     assert (tmp_path / "cmp" / "fit.csv").read_text().strip() == "model,alpha_w,beta_n,xi_asymptote,mass_kg"
