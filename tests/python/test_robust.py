@@ -396,3 +396,30 @@ def test_a_device_as_robot_file_fails_at_once(tmp_path: Path):
     path.write_text(scenario_text("stand_six_legs", robot='"/dev/zero"'))
     with pytest.raises(ValueError, match="scenario.robot.*not a regular file"):
         _core.load_scenario(str(path))
+
+
+# ---------------------------------------------------------------------------------------------
+# 5. Every shipped scenario passes its health checks: `hexadyn simulate NAME --strict` exits 0.
+# ---------------------------------------------------------------------------------------------
+
+#: The simulated time of a run of the test below: a shipped scenario longer than this (19 of
+#: 47, up to 1000 s; in full, about 2.5 minutes of engine time alone on the shared 2-core
+#: machine, before streaming and analysing the series) runs its first STRICT_CAP_S seconds only
+#: (`--set scenario.duration_s`); the others run in full (the whole test: about 50 s).
+STRICT_CAP_S = 120.0
+#: Shipped scenarios that fail a health check today (the same on main): the breakaway
+#: campaigns close their energy balance to 100 % and 17 % only (the vertical joints are driven
+#: into their limit switches, 6762 cuts: the balance misses what the cuts take).
+UNHEALTHY_SCENARIOS = {"identification_breakaway_minus", "identification_breakaway_plus"}
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="energy balance at the limit switches")) if n in UNHEALTHY_SCENARIOS else n for n in hexadyn.list_scenarios()],
+)
+def test_every_shipped_scenario_passes_strict(name: str, tmp_path: Path):
+    duration = _core.load_scenario(str(hexadyn.resolve_scenario(name)))["duration_s"]
+    cut = ["--set", f"scenario.duration_s={STRICT_CAP_S}"] if duration > STRICT_CAP_S else []
+    result = invoke("simulate", name, *cut, "--strict", "--no-plots", "--no-progress", "--out", str(tmp_path / "run"))
+    assert result.exit_code == 0, result.output
+    assert json.loads((tmp_path / "run" / "summary.json").read_text())["warnings"] == []
