@@ -17,6 +17,7 @@ import click
 import hexadyn
 from hexadyn import _core
 from hexadyn.options import (
+    figure_format_option,
     format_option,
     no_plots_option,
     no_progress_option,
@@ -96,8 +97,6 @@ def cli() -> None:
 def info() -> None:
     """Print what is shipped: the version, the robots (the names `scenario.robot` takes, their
     descriptions printed by `hexadyn robot-file NAME`) and the scenarios."""
-    from hexadyn import _core
-
     click.echo(f"hexadyn {hexadyn.__version__}")
     click.echo(f"engine: {_core.__version__} ({_core.__file__})")
     click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT}")
@@ -114,8 +113,6 @@ def info() -> None:
 def robot_file(robot: str) -> None:
     """Print the description file of the shipped ROBOT (TOML, docs/robot-format.md): the fields
     a robot description needs, the start of one of your own (`> my_robot.toml`)."""
-    from hexadyn import _core
-
     click.echo(_core.shipped_robot_text(robot), nl=False)
 
 
@@ -128,15 +125,10 @@ def _parse_legs(ctx: click.Context, param: click.Parameter, value: str) -> tuple
         raise click.BadParameter(str(exc)) from None
 
 
-#: Figure file formats (hexadyn.plots.FORMATS, not imported here: matplotlib is slow to load).
-FIGURE_FORMATS = ("png", "pdf", "svg")
-#: `--format` of the commands that write figures.
-figure_format_option = format_option(FIGURE_FORMATS, "png", "Figure file formats: png (300 dpi), pdf, svg, comma-separated.", several=True)
-
 #: Options shared by `simulate` and `plot`.
 plot_options = [
     click.option("--legs", default="0,2", show_default=True, callback=_parse_legs, help="Legs of the per-actuator figures: comma-separated 0..5, or all."),
-    figure_format_option,
+    figure_format_option(),
 ]
 
 
@@ -305,7 +297,7 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @workers_option()
 @no_progress_option()
 @no_plots_option()
-@figure_format_option
+@figure_format_option()
 def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, format_: tuple[str, ...]) -> None:
     """Run the validation walk with each friction model at several velocities (Section 6.4).
 
@@ -350,8 +342,6 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
 @cli.command()
 def scenarios() -> None:
     """List the shipped scenarios (run one with `hexadyn simulate NAME`)."""
-    from hexadyn import _core
-
     files = hexadyn.scenario_files()
     click.echo(f"Shipped scenarios ({hexadyn.SCENARIOS_DIR}):")
     width = max((len(p.stem) for p in files), default=0)

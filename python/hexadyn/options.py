@@ -20,6 +20,7 @@ import click
 __all__ = [
     "COMMON",
     "CommonOption",
+    "figure_format_option",
     "format_option",
     "no_plots_option",
     "no_progress_option",
@@ -57,22 +58,36 @@ def workers_option(help: str = "Parallel simulations (default: every core).") ->
     return click.option("--workers", cls=CommonOption, type=click.IntRange(min=1), default=None, help=help)
 
 
-def format_option(allowed: Sequence[str], default: str | None, help: str, *, several: bool, required: bool = False) -> Callable[[F], F]:
-    """``--format``: one of `allowed`, or with `several` a comma-separated list of them (the
-    value is then a tuple, duplicates dropped)."""
+def format_option(allowed: Sequence[str] | Callable[[], Sequence[str]], default: str | None, help: str, *, several: bool, required: bool = False) -> Callable[[F], F]:
+    """``--format``: one of `allowed` (or of what it returns, asked when the option is parsed),
+    or with `several` a comma-separated list of them (the value is then a tuple, duplicates
+    dropped)."""
 
     def parse(ctx: click.Context, param: click.Parameter, value: str | None) -> Any:
         if value is None:
             return None
+        allowed_now = allowed() if callable(allowed) else allowed
         chosen = tuple(dict.fromkeys(f.strip().lower() for f in value.split(",") if f.strip()))
-        if not chosen or any(f not in allowed for f in chosen) or (not several and len(chosen) > 1):
-            listing = f"comma-separated formats among {', '.join(allowed)}" if several else f"one of {', '.join(allowed)}"
+        if not chosen or any(f not in allowed_now for f in chosen) or (not several and len(chosen) > 1):
+            listing = f"comma-separated formats among {', '.join(allowed_now)}" if several else f"one of {', '.join(allowed_now)}"
             raise click.BadParameter(f"{value!r}; allowed: {listing}")
         return chosen if several else chosen[0]
 
     # No default at all when there is none: click checks a required option only then.
     defaults = {} if default is None else {"default": default, "show_default": True}
     return click.option("--format", "format_", cls=CommonOption, required=required, callback=parse, help=help, **defaults)
+
+
+def figure_format_option() -> Callable[[F], F]:
+    """``--format`` of the commands that draw figures: formats of :data:`hexadyn.plots.FORMATS`,
+    comma-separated (matplotlib is imported when the option is parsed, not before)."""
+
+    def figure_formats() -> Sequence[str]:
+        from hexadyn.plots import FORMATS
+
+        return FORMATS
+
+    return format_option(figure_formats, "png", "Figure file formats: png (300 dpi), pdf, svg, comma-separated.", several=True)
 
 
 def no_progress_option() -> Callable[[F], F]:

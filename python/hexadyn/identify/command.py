@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from hexadyn.options import format_option, no_progress_option, out_option, overwrite_option
+from hexadyn.options import figure_format_option, no_progress_option, out_option, overwrite_option
 
 __all__ = ["identify_command"]
 
@@ -18,7 +18,7 @@ __all__ = ["identify_command"]
 @overwrite_option()
 @click.option("--robot", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Robot description file of CSV logs, e.g. robots/phantomx/phantomx.toml (default: the embedded AMRU5); a results folder carries its own.")
 @click.option("--transient", "transient_s", type=click.FloatRange(min=0.0), default=1.5, show_default=True, help="Seconds dropped after each reversal (velocity transient).")
-@format_option(("png", "pdf", "svg"), "png", "Figure file formats: png (300 dpi), pdf, svg, comma-separated.", several=True)
+@figure_format_option()
 @no_progress_option()
 def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overwrite: bool, robot: Path | None, transient_s: float, format_: tuple[str, ...], no_progress: bool) -> None:
     """Identify joint friction from LOGS: results folders of the identification scenarios
