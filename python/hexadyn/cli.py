@@ -1,7 +1,9 @@
 """The ``hexadyn`` command line.
 
-User errors end with one line on stderr (``Error: ...``) and exit status 1, never a traceback.
-Set ``HEXADYN_DEBUG=1`` to see the traceback of such an error.
+User errors end with one line on stderr (``Error: ...``) and exit status 1, never a traceback;
+a wrong command line (an unknown option, a bad option value) with one line too and exit status
+2. Set ``HEXADYN_DEBUG=1`` to see the traceback of such an error. The options shared by several
+commands are spelled the same in all of them (:mod:`hexadyn.options`, docs/cli.md).
 """
 
 from __future__ import annotations
@@ -13,7 +15,18 @@ from pathlib import Path
 import click
 
 import hexadyn
-from hexadyn import atomic
+from hexadyn import _core, atomic
+from hexadyn.options import (
+    figure_format_option,
+    format_option,
+    no_plots_option,
+    no_progress_option,
+    out_option,
+    overwrite_option,
+    set_option,
+    strict_option,
+    workers_option,
+)
 from hexadyn.runner import RESULTS_ROOT, free_results_folder
 
 #: Scenario run by `hexadyn simulate` without an argument (and by `make run`): a shipped scenario
@@ -30,8 +43,33 @@ INTERRUPTED = 130
 UNHEALTHY = 3
 
 
+class OneLineUsageError(click.UsageError):
+    """A wrong command line, shown as one line (without click's usage block) that names the
+    option, the value, what is allowed and where the help is."""
+
+    def __init__(self, error: click.UsageError) -> None:
+        where = f" (see '{error.ctx.command_path} --help')" if error.ctx is not None else ""
+        super().__init__(" ".join(error.format_message().split()) + where)
+
+    def show(self, file=None) -> None:
+        click.echo(f"Error: {self.format_message()}", file=file, err=True)
+
+
+def _usage_in_one_line(error: click.UsageError) -> click.UsageError:
+    """`error` as one line; the help that a group without a command prints stays as it is."""
+    if isinstance(error, (OneLineUsageError, click.exceptions.NoArgsIsHelpError)):
+        return error
+    return OneLineUsageError(error)
+
+
 class HexadynGroup(click.Group):
     """A click group that turns user errors raised by any command into one-line messages."""
+
+    def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
+        try:
+            return super().make_context(info_name, args, parent, **extra)
+        except click.UsageError as exc:
+            raise _usage_in_one_line(exc) from None
 
     def invoke(self, ctx: click.Context):
         # A run killed while saving (kill -9, a power cut) could not remove its temporary
@@ -39,6 +77,8 @@ class HexadynGroup(click.Group):
         atomic.remove_stale(RESULTS_ROOT)
         try:
             return super().invoke(ctx)
+        except click.UsageError as exc:
+            raise _usage_in_one_line(exc) from None
         except USER_ERRORS as exc:
             if os.environ.get("HEXADYN_DEBUG"):
                 raise
@@ -58,17 +98,25 @@ def cli() -> None:
 
 @cli.command()
 def info() -> None:
-    """Print the engine version and the shipped robots (the names `scenario.robot` takes)."""
-    from hexadyn import _core
-
+    """Print what is shipped: the version, the robots (the names `scenario.robot` takes, their
+    descriptions printed by `hexadyn robot-file NAME`) and the scenarios."""
     click.echo(f"hexadyn {hexadyn.__version__}")
     click.echo(f"engine: {_core.__version__} ({_core.__file__})")
     click.echo(f"default robot: {hexadyn.DEFAULT_ROBOT}")
-    click.echo("shipped robots (scenario.robot):")
+    click.echo("shipped robots (scenario.robot; the description file: hexadyn robot-file NAME):")
     for name in _core.SHIPPED_ROBOTS:
         p = _core.robot_properties(_core.shipped_robot_text(name), name)
         joints = ", ".join(f"{j} ({kind})" for j, kind in p["joints"])
         click.echo(f"  {name:<9} {p['leg_mechanism']} legs, {p['mass_kg']:.3f} kg, joints {joints}")
+    click.echo(f"shipped scenarios: {len(hexadyn.list_scenarios())} in {hexadyn.SCENARIOS_DIR} (hexadyn scenarios lists them)")
+
+
+@cli.command("robot-file")
+@click.argument("robot", type=click.Choice(list(_core.SHIPPED_ROBOTS)))
+def robot_file(robot: str) -> None:
+    """Print the description file of the shipped ROBOT (TOML, docs/robot-format.md): the fields
+    a robot description needs, the start of one of your own (`> my_robot.toml`)."""
+    click.echo(_core.shipped_robot_text(robot), nl=False)
 
 
 def _parse_legs(ctx: click.Context, param: click.Parameter, value: str) -> tuple[int, ...]:
@@ -80,19 +128,10 @@ def _parse_legs(ctx: click.Context, param: click.Parameter, value: str) -> tuple
         raise click.BadParameter(str(exc)) from None
 
 
-def _parse_formats(ctx: click.Context, param: click.Parameter, value: str) -> tuple[str, ...]:
-    from hexadyn import plots
-
-    formats = tuple(dict.fromkeys(f.strip().lower() for f in value.split(",") if f.strip()))
-    if not formats or any(f not in plots.FORMATS for f in formats):
-        raise click.BadParameter(f"{value!r}; allowed: comma-separated formats among {', '.join(plots.FORMATS)}")
-    return formats
-
-
 #: Options shared by `simulate` and `plot`.
 plot_options = [
     click.option("--legs", default="0,2", show_default=True, callback=_parse_legs, help="Legs of the per-actuator figures: comma-separated 0..5, or all."),
-    click.option("--formats", default="png", show_default=True, callback=_parse_formats, help="Figure file formats: png (300 dpi), pdf, svg, comma-separated."),
+    figure_format_option(),
 ]
 
 
@@ -104,22 +143,18 @@ def with_plot_options(f):
 
 @cli.command()
 @click.argument("scenario", required=False, default=None)
-@click.option(
-    "-o",
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=None,
-    help="Results folder (default: results/<scenario name>, numbered if it exists).",
-)
-@click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
-@click.option("--no-plots", is_flag=True, help="Do not write the figures into <out>/plots/.")
-@click.option("--strict", is_flag=True, help=f"Exit with status {UNHEALTHY} if a health check of the run fails (see `warnings` in summary.json).")
+@set_option()
+@out_option("Results folder (default: results/<scenario name>, numbered if it exists).")
+@overwrite_option()
+@no_progress_option()
+@no_plots_option()
+@strict_option(UNHEALTHY)
 @with_plot_options
-def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
+def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, legs: tuple[int, ...], format_: tuple[str, ...]) -> None:
     """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
 
-    Without SCENARIO the default scenario is run (see `hexadyn scenarios`). The results folder
+    Without SCENARIO the default scenario is run (see `hexadyn scenarios`); --set changes its
+    fields (its description then says so: `[derived: ...]`). The results folder
     gets the time series (streamed to disk as the run goes), the summary, the power and energy
     tables (power.csv, energy.csv) and, unless --no-plots, the figures in plots/ (see `hexadyn
     plot`). Every run checks its own health (energy balance, penetration, body fall, tracking);
@@ -128,12 +163,13 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
     """
     from hexadyn import report
 
-    path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
+    run = _scenario(scenario, overrides)
+    path = run.path
     if out is not None and out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
     # Without --out: results/<scenario name>, numbered. The scenario is validated before
     # anything is created: a bad scenario leaves no results folder behind.
-    results = hexadyn.simulate(path, out, progress=not no_progress, save=True, overwrite=overwrite, plots=not no_plots, legs=legs, formats=formats)
+    results = run.simulate(out, progress=not no_progress, save=True, overwrite=overwrite, plots=not no_plots, legs=legs, formats=format_)
     out = results.path
     s = results.summary
     click.echo(f"Results: {out}")
@@ -166,6 +202,15 @@ def simulate(scenario: str | None, out: Path | None, overwrite: bool, no_progres
         click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
     if s["warnings"] and strict:
         raise SystemExit(UNHEALTHY)
+
+
+def _scenario(scenario: str | None, overrides: dict) -> hexadyn.Scenario:
+    """SCENARIO (default: :data:`DEFAULT_SCENARIO`) with the fields of --set, each checked by
+    the engine as it is set."""
+    run = hexadyn.Scenario.load(scenario or DEFAULT_SCENARIO)
+    for field, value in overrides.items():
+        run.set(field, value)
+    return run
 
 
 def _echo_power(results: hexadyn.Results) -> None:
@@ -222,15 +267,16 @@ def ground_detection_table(folder: Path) -> None:
 @cli.command()
 @click.argument("folder", type=click.Path(file_okay=False, path_type=Path))
 @with_plot_options
-def plot(folder: Path, legs: tuple[int, ...], formats: tuple[str, ...]) -> None:
+@no_progress_option()
+def plot(folder: Path, legs: tuple[int, ...], format_: tuple[str, ...], no_progress: bool) -> None:
     """(Re)generate the figures of the results FOLDER into FOLDER/plots/ (replaced atomically)."""
     from hexadyn import report
 
     results = hexadyn.Results.load(folder)
     if not report.in_memory(results):
         raise ValueError(f"{folder}: the time series ({results.shape[0]} instants) is too long to plot in memory; plot a part of it from Python (Results.read_columns)")
-    figures = report.plot(results, folder / "plots", legs=legs, formats=formats)
-    click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(formats)} formats)")
+    figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
+    click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(format_)} formats)")
 
 
 def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | None) -> tuple[float, ...] | None:
@@ -248,30 +294,33 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @click.argument("scenario", required=False, default=None)
 @click.option("--velocities", default="1,1.5,2,2.5", show_default=True, callback=_parse_velocities, help="Forward velocities V_x in cm/s (Table 6.2, Fig. 6.19), comma-separated.")
 @click.option("--models", default=None, help="Friction models, comma-separated (default: all four: none, dry_viscous, lugre, dry_viscous_load).")
-@click.option("-o", "--out", type=click.Path(file_okay=False, path_type=Path), default=None, help="Output folder (default: results/compare_friction_<scenario name>, numbered if it exists).")
-@click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
-@click.option("-j", "--jobs", type=click.IntRange(min=1), default=None, help="Worker processes (default: one per CPU).")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
-@click.option("--formats", default="png", show_default=True, callback=_parse_formats, help="Figure file formats: png (300 dpi), pdf, svg, comma-separated.")
-def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, out: Path | None, overwrite: bool, jobs: int | None, no_progress: bool, formats: tuple[str, ...]) -> None:
+@set_option()
+@out_option("Output folder (default: results/compare_friction_<scenario name>, numbered if it exists).")
+@overwrite_option()
+@workers_option()
+@no_progress_option()
+@no_plots_option()
+@figure_format_option()
+def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, format_: tuple[str, ...]) -> None:
     """Run the validation walk with each friction model at several velocities (Section 6.4).
 
     SCENARIO (default: the validation case of Table 6.2) is run without friction, with the
     dry/viscous model, with LuGre, and with the dry/viscous model plus the load dependence of the
     horizontal joints, at each velocity, in parallel. Writes the averaged power per actuator and
     model (Tables 6.3-6.6), the robot power and specific resistance versus velocity with the fit
-    P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots.
+    P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots. --set changes the scenario's fields
+    for every run (the friction model and the velocity are set over them).
     """
     from hexadyn import compare, energy
 
-    path = hexadyn.resolve_scenario(scenario or DEFAULT_SCENARIO)
+    path = _scenario(scenario, overrides).path  # the fields of --set checked on the scenario first
     if out is None:
         out = free_results_folder(f"compare_friction_{path.stem}")
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the output folder exists; use --overwrite or another --out")
     names = list(compare.MODELS) if models is None else [m.strip() for m in models.split(",") if m.strip()]
-    result = compare.compare_friction(path, velocities, models=names, jobs=jobs, progress=not no_progress)
-    compare.save(result, out, overwrite=overwrite, formats=formats)
+    result = compare.compare_friction(path, velocities, models=names, workers=workers, progress=not no_progress, overrides=overrides)
+    compare.save(result, out, overwrite=overwrite, formats=format_, with_plots=not no_plots, progress=not no_progress)
     click.echo(f"Friction comparison: {out}")
     fmt = lambda v: f"{v:7.3f}"  # noqa: E731
     for joint, table in compare.joint_tables(result).items():
@@ -296,8 +345,6 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
 @cli.command()
 def scenarios() -> None:
     """List the shipped scenarios (run one with `hexadyn simulate NAME`)."""
-    from hexadyn import _core
-
     files = hexadyn.scenario_files()
     click.echo(f"Shipped scenarios ({hexadyn.SCENARIOS_DIR}):")
     width = max((len(p.stem) for p in files), default=0)
@@ -309,23 +356,25 @@ def scenarios() -> None:
 
 @cli.command()
 @click.argument("scenario", required=False, default=None)
-@click.option("-o", "--out", type=click.Path(path_type=Path), required=True, help="Campaign folder (created, or resumed if it holds the same campaign).")
+@out_option("Campaign folder (created, or resumed if it holds the same campaign).", required=True)
 @click.option("--robot", type=click.Choice(["amru5", "phantomx"]), default=None, help="Without SCENARIO: the shipped robot whose campaign walk to run (amru5: validation_tripod_1_5cm, phantomx: phantomx_montecarlo) [default: amru5].")
 @click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
 @click.option("--variants", default=None, help="Comma-separated friction variants (default: every variant of the robot: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
 @click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
-@click.option("--workers", type=int, default=None, help="Parallel simulations (default: every core).")
+@set_option()
+@workers_option()
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
-def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, workers, ray_address, no_progress) -> None:
+@no_progress_option()
+def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
     Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm, or with --robot
     phantomx the PhantomX's phantomx_montecarlo) for every friction variant, velocity and run,
     with friction drawn per run from the Gaussians of the robot's [monte_carlo] table (AMRU5:
-    Table 6.7), truncated at 3 sigma, physical signs. Rerunning the same command resumes an
+    Table 6.7), truncated at 3 sigma, physical signs; --set changes the scenario's fields for
+    every run (the drawn friction and the velocity are set over them). Rerunning the same command resumes an
     interrupted campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf
     to --out. A campaign with failed simulations (stored, not retried) ends with one line
     naming them and exit status 1.
@@ -351,6 +400,7 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
         variants=listed("--variants", variants, str.strip),
         seed=seed,
         friction_stats=friction_stats,
+        overrides=overrides,
     )
     try:
         table = campaign.run(out, workers=workers, ray=ray_address, progress=not no_progress)
@@ -365,41 +415,57 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
         raise click.ClickException(failure_line(campaign.failures(out), len(campaign.keys()), out))
 
 
+@cli.command("export")
+@click.argument("folder", type=click.Path(file_okay=False, path_type=Path))
+@format_option(("csv", "mcap"), None, "csv: the time series as one table; mcap: channels for Foxglove Studio (body pose, joint states, foot forces, motor currents).", several=False, required=True)
+@out_option("The file to write (default: FOLDER/timeseries.csv or FOLDER/timeseries.mcap).", folder=False)
+@overwrite_option("file")
+def export_command(folder: Path, format_: str, out: Path | None, overwrite: bool) -> None:
+    """Export the results FOLDER for other tools: the time series as CSV, or as an MCAP file of
+    JSON channels logged at the run's times (docs/cli.md lists them)."""
+    from hexadyn import export
+
+    results = hexadyn.Results.load(folder)
+    path = export.export(results, out or folder / f"timeseries{export.FORMATS[format_]}", format_, overwrite=overwrite)
+    written = "every column" if format_ == "csv" else ", ".join(c.topic for c in export.channels(results))
+    click.echo(f"Export: {path} ({results.shape[0]} instants, {written})")
+
+
 @cli.command("import-urdf")
 @click.argument("urdf_file", type=click.Path(path_type=Path))
-@click.option("--out", "out_file", type=click.Path(path_type=Path), required=True, help="The robot description to write (TOML, docs/robot-format.md).")
+@out_option("The robot description to write (TOML, docs/robot-format.md).", required=True, folder=False)
 @click.option("--joint-names", default="coxa,femur,tibia", show_default=True, help="The names of a leg's three joints from the body to the foot, comma-separated: the results' columns.")
 @click.option("--drives", "drives_file", type=click.Path(path_type=Path), default=None, help="A serial robot description whose drives, controller and ground to use [default: the shipped PhantomX's AX-12A servos].")
-@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
-def import_urdf_command(urdf_file: Path, out_file: Path, joint_names: str, drives_file: Path | None, overwrite: bool) -> None:
+@overwrite_option("file")
+def import_urdf_command(urdf_file: Path, out: Path, joint_names: str, drives_file: Path | None, overwrite: bool) -> None:
     """Write a hexadyn robot description of a URDF hexapod (six chains of three joints)."""
     from hexadyn.urdf import import_urdf
 
     names = tuple(n.strip() for n in joint_names.split(","))
-    path = import_urdf(urdf_file, out_file, names, drives_file, overwrite)
+    path = import_urdf(urdf_file, out, names, drives_file, overwrite)
     click.echo(f"Robot description: {path} (scenario.robot = \"{path}\"; check its drives)")
 
 
 @cli.command("export-urdf")
 @click.argument("robot")
-@click.argument("out_file", type=click.Path(path_type=Path))
-@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
-def export_urdf_command(robot: str, out_file: Path, overwrite: bool) -> None:
-    """Write a serial robot (shipped name or description file) as URDF, for ROS and MuJoCo users."""
+@out_option("The URDF file to write.", required=True, folder=False)
+@overwrite_option("file")
+def export_urdf_command(robot: str, out: Path, overwrite: bool) -> None:
+    """Write a serial ROBOT (shipped name or description file) as URDF, for ROS and MuJoCo users."""
     from hexadyn.urdf import export_urdf
 
-    click.echo(f"URDF: {export_urdf(robot, out_file, overwrite)}")
+    click.echo(f"URDF: {export_urdf(robot, out, overwrite)}")
 
 
 @cli.command("export-mjcf")
 @click.argument("robot")
-@click.argument("out_file", type=click.Path(path_type=Path))
-@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
-def export_mjcf_command(robot: str, out_file: Path, overwrite: bool) -> None:
-    """Write a robot (shipped name or description file, either leg mechanism) as MuJoCo MJCF."""
+@out_option("The MJCF file to write.", required=True, folder=False)
+@overwrite_option("file")
+def export_mjcf_command(robot: str, out: Path, overwrite: bool) -> None:
+    """Write a ROBOT (shipped name or description file, either leg mechanism) as MuJoCo MJCF."""
     from hexadyn.urdf import export_mjcf
 
-    click.echo(f"MJCF: {export_mjcf(robot, out_file, overwrite)}")
+    click.echo(f"MJCF: {export_mjcf(robot, out, overwrite)}")
 
 
 @cli.command("urdf")

@@ -29,7 +29,7 @@ import os
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -93,28 +93,29 @@ class Comparison:
     table_velocity: float
 
 
-def _overrides(scenario: Path, model: str, velocity: float) -> dict[str, Any]:
-    return {**MODELS[model], VELOCITY_FIELD: velocity, "scenario.name": f"{scenario.stem}_{model}_{velocity * 100:g}cm"}
+def _overrides(scenario: Path, base: Mapping[str, Any], model: str, velocity: float) -> dict[str, Any]:
+    """The fields of one run: the caller's `base` fields, then the model's and the velocity."""
+    return {**base, **MODELS[model], VELOCITY_FIELD: velocity, "scenario.name": f"{scenario.stem}_{model}_{velocity * 100:g}cm"}
 
 
-def _validate(scenario: Path, runs: Sequence[tuple[str, float]]) -> None:
+def _validate(scenario: Path, base: Mapping[str, Any], runs: Sequence[tuple[str, float]]) -> None:
     """Checks the scenario and every run without simulating."""
     from hexadyn import _core
 
-    gait = _core.load_scenario(os.fspath(scenario))["gait"]
+    gait = _core.load_scenario(os.fspath(scenario), dict(base) or None)["gait"]
     if gait is None or gait["heading"] != "constant":
         raise ValueError(f"{scenario}: the friction comparison needs a walking scenario with a constant heading ([control] mode = \"gait\", [gait.heading] kind = \"constant\")")
     for model, velocity in runs:
         try:
-            _core.load_scenario(os.fspath(scenario), _overrides(scenario, model, velocity))
+            _core.load_scenario(os.fspath(scenario), _overrides(scenario, base, model, velocity))
         except ValueError as exc:
             raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
 
 
-def _run(scenario: str, model: str, velocity: float) -> dict[str, Any]:
+def _run(scenario: str, base: Mapping[str, Any], model: str, velocity: float) -> dict[str, Any]:
     """One run (in a worker process): its averaged power table and robot figures."""
     try:
-        results = simulate(scenario, progress=False, overrides=_overrides(Path(scenario), model, velocity))
+        results = simulate(scenario, progress=False, overrides=_overrides(Path(scenario), base, model, velocity))
     except ValueError as exc:
         raise ValueError(f"friction model {model}, V_x = {velocity:g} m/s: {exc}") from None
     s = results.summary
@@ -140,8 +141,9 @@ def compare_friction(
     velocities: Sequence[float] = DEFAULT_VELOCITIES,
     *,
     models: Sequence[str] = tuple(MODELS),
-    jobs: int | None = None,
+    workers: int | None = None,
     progress: bool | Callable[[int, int], object] = True,
+    overrides: Mapping[str, Any] | None = None,
 ) -> Comparison:
     """Runs `scenario` with every friction model at every velocity (m/s) and tabulates them.
 
@@ -150,8 +152,11 @@ def compare_friction(
         velocities: forward velocities V_x (m/s); the fit (``fit``) needs two distinct ones and is
             empty with a single velocity.
         models: names among :data:`MODELS`.
-        jobs: worker processes (default: the number of CPUs, at most the number of runs).
+        workers: worker processes (default: the number of CPUs, at most the number of runs).
         progress: a tqdm bar over the runs (True), none (False), or ``progress(done, total)``.
+        overrides: scenario fields set on every run, by dotted name (the ``overrides=`` of
+            :func:`hexadyn.simulate`); the model's fields, the velocity and the name of a run
+            are set over them.
 
     Raises ValueError naming the model, the velocity and the field for a run the scenario
     cannot take (e.g. a velocity whose stride does not fit the workspace).
@@ -162,12 +167,13 @@ def compare_friction(
     if unknown or not models:
         raise ValueError(f"friction models {', '.join(map(str, unknown)) or 'none given'}; allowed: {', '.join(MODELS)}")
     runs = [(m, v) for v in velocities for m in models]
-    _validate(path, runs)  # before any run starts
-    workers = max(1, min(jobs or os.cpu_count() or 1, len(runs)))
+    base = dict(overrides or {})
+    _validate(path, base, runs)  # before any run starts
+    workers = max(1, min(workers or os.cpu_count() or 1, len(runs)))
     outputs = []
     bar = _progress_bar(progress, len(runs))
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run, os.fspath(path), m, v) for m, v in runs]
+        futures = [pool.submit(_run, os.fspath(path), base, m, v) for m, v in runs]
         try:
             for future in as_completed(futures):
                 outputs.append(future.result())
@@ -178,7 +184,7 @@ def compare_friction(
             raise
         finally:
             bar(None)
-    return _tabulate(Path(path).stem, outputs, velocities, list(models), _scenario_velocity(path))
+    return _tabulate(Path(path).stem, outputs, velocities, list(models), _scenario_velocity(path, base))
 
 
 def _check_velocities(velocities: Sequence[float]) -> list[float]:
@@ -188,11 +194,12 @@ def _check_velocities(velocities: Sequence[float]) -> list[float]:
     return sorted(set(v))
 
 
-def _scenario_velocity(path: Path) -> float | None:
-    """The scenario's own V_x, as the engine read it (None without a constant heading)."""
+def _scenario_velocity(path: Path, base: Mapping[str, Any]) -> float | None:
+    """The scenario's own V_x (with the `base` fields), as the engine read it (None without a
+    constant heading)."""
     from hexadyn import _core
 
-    gait = _core.load_scenario(os.fspath(path))["gait"]
+    gait = _core.load_scenario(os.fspath(path), dict(base) or None)["gait"]
     return None if gait is None else gait["vx_m_s"]
 
 
@@ -286,19 +293,29 @@ def figures(comparison: Comparison) -> dict[str, Figure]:
     return out
 
 
-def save(comparison: Comparison, folder: str | os.PathLike, *, overwrite: bool = False, formats: Sequence[str] = plots.DEFAULT_FORMATS) -> Path:
-    """Writes the tables and figures of a comparison into `folder`, atomically."""
+def save(
+    comparison: Comparison,
+    folder: str | os.PathLike,
+    *,
+    overwrite: bool = False,
+    formats: Sequence[str] = plots.DEFAULT_FORMATS,
+    with_plots: bool = True,
+    progress: bool = False,
+) -> Path:
+    """Writes the tables and (with `with_plots`) the figures of a comparison into `folder`,
+    atomically; `progress`: a bar over the figures (:func:`hexadyn.plots.save_figures`)."""
     target = Path(folder)
     if not overwrite:
         atomic.refuse_existing(target, "comparison folder")
-    figs = figures(comparison)
+    figs = figures(comparison) if with_plots else {}
 
     def write(tmp: Path) -> None:
         write_csv(tmp / POWER_FILE, comparison.power)
         write_csv(tmp / ROBOT_FILE, comparison.robot)
         write_csv(tmp / FIT_FILE, comparison.fit)
-        (tmp / "plots").mkdir()
-        plots.save_figures(figs, tmp / "plots", formats)
+        if figs:
+            (tmp / "plots").mkdir()
+            plots.save_figures(figs, tmp / "plots", formats, progress=progress)
 
     atomic.write_folder(target, write)
     return target

@@ -28,7 +28,7 @@ catch what a reader of the figures would catch:
 - any non-finite figure.
 
 The thresholds are stated with their reasons next to them; every shipped scenario passes them
-(``tests/python/test_robust.py``).
+(``hexadyn simulate NAME --strict``, ``tests/python/test_robust.py``).
 """
 
 from __future__ import annotations

@@ -468,21 +468,27 @@ def ground_detection_figure(results: Results, leg: int | None = None) -> Figure:
     return fig
 
 
-def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS) -> list[Path]:
+def save_figures(figs: Mapping[str, Figure], folder: str | Path, formats: Sequence[str] = DEFAULT_FORMATS, *, progress: bool = False) -> list[Path]:
     """Writes every figure as ``folder/<stem>.<format>`` (PNG at 300 dpi); returns the paths.
 
     The folder must exist. Use :func:`hexadyn.report.plot` or :func:`hexadyn.report.save` to
-    write a complete plots folder atomically.
+    write a complete plots folder atomically. `progress`: a tqdm bar on stderr that advances
+    figure by figure, naming the one being drawn (the drawing takes most of the time: 0.3 s
+    a PNG, vector files about twice that).
     """
+    from tqdm.auto import tqdm
+
     bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
         raise ValueError(f"plot formats = {', '.join(formats) or 'none'}; allowed: one or more of {', '.join(FORMATS)}")
     folder = Path(folder)
     paths = []
-    with style():
+    with style(), tqdm(total=len(figs), desc="plots", unit="figure", disable=not progress) as bar:
         for stem, fig in figs.items():
+            bar.set_postfix_str(stem, refresh=False)
             for fmt in formats:
                 path = folder / f"{stem}.{fmt}"
                 fig.savefig(path, format=fmt, dpi=DPI)
                 paths.append(path)
+            bar.update()
     return paths

@@ -46,6 +46,7 @@ def save(
     plots: bool = False,
     legs: Sequence[int] | None = None,
     formats: Sequence[str] | None = None,
+    progress: bool = False,
 ) -> Path:
     """Writes the results folder atomically and returns its path (also set as ``results.path``).
 
@@ -54,12 +55,12 @@ def save(
     folder appears or nothing does (a failure removes the temporary folder and any parent
     folders this call created). An existing ``folder`` is an error (FileExistsError) unless
     ``overwrite`` is true, in which case it is replaced only once the new folder is complete.
-    ``legs`` and ``formats`` are those of :func:`plot`.
+    ``legs``, ``formats`` and ``progress`` are those of :func:`plot`.
     """
     if not overwrite:
         atomic.refuse_existing(folder, "results folder")
     figures = _figures(results, legs) if plots and in_memory(results) else None  # before anything is written
-    save_run(lambda tmp: results, folder, overwrite=overwrite, plots=plots, legs=legs, formats=formats, figures=figures)
+    save_run(lambda tmp: results, folder, overwrite=overwrite, plots=plots, legs=legs, formats=formats, figures=figures, progress=progress)
     return Path(folder)
 
 
@@ -72,6 +73,7 @@ def save_run(
     legs: Sequence[int] | None = None,
     formats: Sequence[str] | None = None,
     figures: Mapping[str, Figure] | None = None,
+    progress: bool = False,
 ) -> Results:
     """:func:`save` of the results ``run(tmp)`` returns, called with the temporary folder so
     that it may stream its time series there (:func:`hexadyn.simulate`). The power table and
@@ -98,7 +100,7 @@ def save_run(
             write_csv(tmp / ground_detection.TABLE_FILE, ground_detection.table(stops))
         if plots and small:
             (tmp / PLOTS_DIR).mkdir()
-            _save_figures(figures if figures is not None else _figures(results, legs), tmp / PLOTS_DIR, formats)
+            _save_figures(figures if figures is not None else _figures(results, legs), tmp / PLOTS_DIR, formats, progress)
 
     atomic.write_folder(target, write)
     results = kept[0]
@@ -117,6 +119,7 @@ def plot(
     *,
     legs: Sequence[int] | None = None,
     formats: Sequence[str] | None = None,
+    progress: bool = False,
 ) -> dict[str, Figure]:
     """Builds the figures of the results and, with ``folder``, writes them there.
 
@@ -125,11 +128,12 @@ def plot(
     ``legs``: the legs of the per-actuator figures (default 0 and 2, as in Section 6.4).
     ``formats``: file formats among png (300 dpi), pdf and svg (default png). The folder is
     written atomically and replaces an existing one: ``report.plot(results, results.path /
-    "plots")`` regenerates the plots of a saved results folder.
+    "plots")`` regenerates the plots of a saved results folder. ``progress``: a bar on stderr
+    over the figures as they are written (:func:`hexadyn.plots.save_figures`).
     """
     figures = _figures(results, legs)
     if folder is not None:
-        atomic.write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats))
+        atomic.write_folder(Path(folder), lambda tmp: _save_figures(figures, tmp, formats, progress))
     return figures
 
 
@@ -143,5 +147,5 @@ def _figures(results: Results, legs: Sequence[int] | None) -> dict[str, Figure]:
     return plotting.figures(results, plotting.DEFAULT_LEGS if legs is None else legs)
 
 
-def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence[str] | None) -> None:
-    plotting.save_figures(figures, folder, plotting.DEFAULT_FORMATS if formats is None else formats)
+def _save_figures(figures: Mapping[str, Figure], folder: Path, formats: Sequence[str] | None, progress: bool) -> None:
+    plotting.save_figures(figures, folder, plotting.DEFAULT_FORMATS if formats is None else formats, progress=progress)

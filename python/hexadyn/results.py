@@ -182,6 +182,21 @@ class Results:
             return self._timeseries[list(columns)]
         return _read_parquet(self._series_file(), columns=list(columns))
 
+    def iter_chunks(self, columns: Sequence[str], rows: int = 10_000) -> Iterator[pd.DataFrame]:
+        """Some columns of the time series (indexed by ``t``), `rows` instants at a time, read
+        from the file batch by batch if the series is not in memory: the way through a series
+        too long for memory."""
+        if self._timeseries is not None:
+            frame = self._timeseries[list(columns)]
+            for start in range(0, len(frame), rows):
+                yield frame.iloc[start : start + rows]
+            return
+        import pyarrow.parquet as pq
+
+        file = pq.ParquetFile(self._series_file())
+        for batch in file.iter_batches(batch_size=rows, columns=list(columns), use_pandas_metadata=True, use_threads=False):
+            yield batch.to_pandas()
+
     def endpoints(self) -> pd.DataFrame:
         """The first and the last instant of the time series (two rows), read from the file if
         the series is not in memory (:func:`_read_row`: a few columns at a time)."""

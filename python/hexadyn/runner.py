@@ -92,8 +92,10 @@ def simulate(
         scenario: a scenario file, or the name of a shipped scenario (see :func:`list_scenarios`).
         out: if given, the results are saved to this folder (atomically, with the power tables,
             see :func:`hexadyn.report.save`); it must not exist unless ``overwrite`` is true.
-        progress: True for a tqdm progress bar over the simulated time (on stderr), False for
-            none, or a callable ``progress(t_s, duration_s)`` called about every 1 % of the run.
+        progress: True for a tqdm progress bar over the simulated time (on stderr), and one
+            over the figures written (`plots`), False for none, or a callable
+            ``progress(t_s, duration_s)`` called about every 1 % of the run (no bar of the
+            figures then).
         save: without `out`, save the results to ``results/<scenario name>`` (relative to the
             working directory), or ``results/<scenario name>-2``, ``-3``... if it exists, as
             ``hexadyn simulate`` does (:func:`free_results_folder`); ``results.path`` tells which.
@@ -157,7 +159,7 @@ def simulate(
         results.path = tmp
         return finish(results)
 
-    return report.save_run(record, out, overwrite=overwrite, plots=plots, legs=legs, formats=formats)
+    return report.save_run(record, out, overwrite=overwrite, plots=plots, legs=legs, formats=formats, progress=progress is True)
 
 
 def _refuse_beyond(rows: int, columns: int, limit: float, where: str, advice: str) -> None:

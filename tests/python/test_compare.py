@@ -26,7 +26,7 @@ def short_walk(tmp_path_factory) -> Path:
 
 def test_cli_compare_friction(short_walk: Path, tmp_path: Path):
     out = tmp_path / "cmp"
-    result = CliRunner().invoke(cli, ["compare-friction", str(short_walk), "--velocities", "1,2", "--out", str(out), "--jobs", "2", "--no-progress"], prog_name="hexadyn")
+    result = CliRunner().invoke(cli, ["compare-friction", str(short_walk), "--velocities", "1,2", "--out", str(out), "--workers", "2", "--no-progress"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
     for text in ["averaged power of the q_r actuators (W), V_x = 1 cm/s", "q_h actuators", "dry_viscous_load", "specific_resistance", "alpha_w"]:
         assert text in result.output, text

@@ -87,11 +87,11 @@ def test_the_exported_urdf_is_the_same_mechanism(tmp_path):
     from hexadyn._core import UrdfHexapod
 
     out = tmp_path / "phantomx.urdf"
-    result = CliRunner().invoke(cli, ["export-urdf", "phantomx", str(out)])
+    result = CliRunner().invoke(cli, ["export-urdf", "phantomx", "--out", str(out)])
     assert result.exit_code == 0, result.output
     exported, original = UrdfHexapod.from_file(str(out)), UrdfHexapod.from_file(str(PHANTOMX_URDF))
     q = np.random.default_rng(1).uniform(-0.5, 0.5, 24)
     np.testing.assert_allclose(exported.mass_matrix(q), original.mass_matrix(q), rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(exported.feet(q), original.feet(q), rtol=1e-12, atol=1e-15)
-    bad = CliRunner().invoke(cli, ["export-urdf", "amru5", str(tmp_path / "amru5.urdf")])
+    bad = CliRunner().invoke(cli, ["export-urdf", "amru5", "--out", str(tmp_path / "amru5.urdf")])
     assert bad.exit_code != 0 and "pantograph legs" in bad.output and len(bad.output.strip().splitlines()) == 1

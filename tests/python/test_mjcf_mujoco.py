@@ -108,14 +108,14 @@ def test_export_mjcf_writes_either_leg_mechanism(tmp_path):
     }
     for robot, mass in masses.items():
         out = tmp_path / f"{robot}.xml"
-        result = CliRunner().invoke(cli, ["export-mjcf", robot, str(out)])
+        result = CliRunner().invoke(cli, ["export-mjcf", robot, "-o", str(out)])
         assert result.exit_code == 0, result.output
         model = mujoco.MjModel.from_xml_path(str(out))
         assert abs(model.body_mass.sum() - mass) < 1e-9 * mass, robot
-        again = CliRunner().invoke(cli, ["export-mjcf", robot, str(out)])
+        again = CliRunner().invoke(cli, ["export-mjcf", robot, "-o", str(out)])
         assert again.exit_code != 0 and "--overwrite" in again.output and len(again.output.strip().splitlines()) == 1
     broken = tmp_path / "broken.toml"
     broken.write_text(shipped_robot_text("amru5").replace("[geometry", "[geometry_", 1))
-    bad = CliRunner().invoke(cli, ["export-mjcf", str(broken), str(tmp_path / "broken.xml")])
+    bad = CliRunner().invoke(cli, ["export-mjcf", str(broken), "--out", str(tmp_path / "broken.xml")])
     assert bad.exit_code != 0 and "broken.toml" in bad.output and len(bad.output.strip().splitlines()) == 1, bad.output
     assert not (tmp_path / "broken.xml").exists()

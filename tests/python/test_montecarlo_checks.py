@@ -139,8 +139,15 @@ def test_workers_are_capped_at_the_runs(scenario, tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("workers", ["0", "-3"])
 def test_bad_workers_are_one_line_and_create_nothing(scenario, tmp_path, workers):
+    """A usage error (exit status 2), as in every command taking --workers (test_cli_grammar.py);
+    the API refuses them too."""
     out = tmp_path / "mc"
-    assert_one_line_error(invoke(str(scenario), "--out", str(out), "--workers", workers), f"workers = {workers}: need an integer >= 1")
+    result = invoke(str(scenario), "--out", str(out), "--workers", workers)
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1, result.stderr
+    assert result.stderr.startswith(f"Error: Invalid value for '--workers': {workers} is not in the range x>=1. (see '") and "montecarlo --help')" in result.stderr
+    assert not out.exists()
+    with pytest.raises(ValueError, match=f"workers = {workers}: need an integer >= 1"):
+        Campaign.create(scenario, velocities=[0.01], runs_per_velocity=1, variants=["dry_viscous"]).run(out, workers=int(workers), progress=False)
     assert not out.exists()
 
 

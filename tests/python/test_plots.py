@@ -58,8 +58,8 @@ def test_plot_errors_leave_nothing(walk: Results, tmp_path: Path, monkeypatch):
     # A failure while writing the figures: neither the results folder nor a temporary folder.
     real = plots.save_figures
 
-    def failing(figures, folder, formats):
-        real(dict(list(figures.items())[:1]), folder, formats)
+    def failing(figures, folder, formats, progress=False):
+        real(dict(list(figures.items())[:1]), folder, formats, progress=progress)
         raise OSError(28, "No space left on device", str(folder))
 
     monkeypatch.setattr(plots, "save_figures", failing)
@@ -94,7 +94,7 @@ def test_cli_simulate_and_plot(walk_file: Path, tmp_path: Path):
     assert sorted(p.name for p in out.iterdir()) == ["energy.csv", "metadata.json", "plots", "power.csv", "summary.json", "timeseries.parquet"]
 
     # `hexadyn plot` regenerates the plots of a results folder.
-    result = runner.invoke(cli, ["plot", str(out), "--legs", "5", "--formats", "png,svg"], prog_name="hexadyn")
+    result = runner.invoke(cli, ["plot", str(out), "--legs", "5", "--format", "png,svg"], prog_name="hexadyn")
     assert result.exit_code == 0, result.output
     assert "7 figures x 2 formats" in result.output
     assert {p.name for p in (out / "plots").glob("leg*")} == {f"leg5_{j}.{f}" for j in ("q_r", "q_v", "q_h") for f in ("png", "svg")}
@@ -103,7 +103,7 @@ def test_cli_simulate_and_plot(walk_file: Path, tmp_path: Path):
 
     for args, message in [
         (["plot", str(out), "--legs", "7"], "leg = 7"),
-        (["plot", str(out), "--formats", "gif"], "gif"),
+        (["plot", str(out), "--format", "gif"], "gif"),
         (["plot", str(tmp_path / "missing")], "no such results folder"),
         (["plot", str(tmp_path)], "not a hexadyn results folder"),
     ]:

@@ -10,6 +10,7 @@ import click
 
 import hexadyn
 from hexadyn.link import resolve_link
+from hexadyn.options import no_plots_option, no_progress_option, out_option, overwrite_option
 
 LINK_HELP = "Link configuration file (addresses, period, timing, safety), or 'loopback' for the shipped one on 127.0.0.0/8."
 
@@ -78,10 +79,10 @@ def _stall(ctx: click.Context, param: click.Parameter, value: str | None) -> tup
 @robot.command("run")
 @click.argument("scenario")
 @click.option("--link", "link", required=True, help=LINK_HELP)
-@click.option("-o", "--out", type=click.Path(file_okay=False, path_type=Path), default=None, help="Results folder (default: results/<scenario name>-robot, numbered if it exists).")
-@click.option("--overwrite", is_flag=True, help="Replace the --out folder if it exists.")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
-@click.option("--no-plots", is_flag=True, help="Do not write the figures into <out>/plots/.")
+@out_option("Results folder (default: results/<scenario name>-robot, numbered if it exists).")
+@overwrite_option()
+@no_progress_option()
+@no_plots_option()
 @click.option("--emulated", is_flag=True, help="Drive the six emulated slaves in this process instead of the robot, in lock-step on a virtual clock (free ports of the configured addresses, no real time: the same results on any machine).")
 @click.option("--stall-at", callback=_stall, default=None, help="T:MS, with --emulated: the master freezes T seconds after its start for MS milliseconds (virtual time), as a stopped process would: a rehearsal of a master overrun.")
 @_fault_options
@@ -127,7 +128,7 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
     energy.add_energy_figures(results)
     report.save(results, out, overwrite=overwrite)
     if not no_plots:
-        _save_plots(results, out / report.PLOTS_DIR)
+        _save_plots(results, out / report.PLOTS_DIR, progress=not no_progress)
     s = results.summary
     click.echo(f"Results: {out}")
     click.echo(f"  scenario    {info['name']} ({path}) on the link {link_path}")
@@ -145,7 +146,7 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
         raise click.ClickException(raw["stop"])
 
 
-def _save_plots(results, folder: Path) -> None:
+def _save_plots(results, folder: Path, progress: bool) -> None:
     """The figures of `hexadyn simulate` that what the master saw supports: per joint of legs 0
     and 2, the gait diagram, the averaged power and the energy breakdown (not the trajectory:
     the robot has no navigation system to measure its body position)."""
@@ -156,7 +157,7 @@ def _save_plots(results, folder: Path) -> None:
         figures["gait_diagram"] = plots.gait_diagram(results)
     figures["averaged_power"] = plots.averaged_power_figure(results)
     figures["energy_breakdown"] = plots.energy_breakdown_figure(results)
-    atomic.write_folder(folder, lambda tmp: plots.save_figures(figures, tmp, ("png",)))
+    atomic.write_folder(folder, lambda tmp: plots.save_figures(figures, tmp, ("png",), progress=progress))
 
 
 @robot.command("emulate")

@@ -25,9 +25,9 @@ from __future__ import annotations
 import math
 import os
 from contextlib import closing
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Sequence, Union
+from typing import Any, Callable, Iterable, Mapping, Sequence, Union
 
 from hexadyn._core import __version__
 from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
@@ -75,6 +75,9 @@ class Campaign:
     variants: tuple[str, ...]
     seed: int
     distributions: FrictionDistributions
+    #: Scenario fields set on every run by dotted name (``hexadyn montecarlo --set``); a run's
+    #: friction, velocity and name are set over them.
+    fields: dict[str, Any] = field(default_factory=dict)
 
     @classmethod
     def create(
@@ -86,16 +89,20 @@ class Campaign:
         variants: Sequence[str] | None = None,
         seed: int = 0,
         friction_stats: str | os.PathLike | None = None,
+        overrides: Mapping[str, Any] | None = None,
     ) -> Campaign:
         """Validates a campaign; ``None`` takes the robot's ``[monte_carlo]`` defaults (all
         variants for ``variants``). `friction_stats`: a file written by ``hexadyn identify``
-        whose Gaussians replace the robot's (Table 6.7). Raises ValueError (one line) for bad
+        whose Gaussians replace the robot's (Table 6.7). `overrides`: scenario fields set on
+        every run (:attr:`fields`); the campaign's scenario text (``campaign.json``, compared on
+        resuming) is then the effective one, listing them. Raises ValueError (one line) for bad
         input: among others a distribution a draw is too rarely kept from
         (:meth:`FrictionDistributions.check`) or more than :data:`MAX_SIMULATIONS` runs."""
         from hexadyn import _core
 
         path = resolve_scenario(scenario)
-        info = _core.load_scenario(os.fspath(path))
+        fields = dict(overrides or {})
+        info = _core.load_scenario(os.fspath(path), fields or None)
         if info["gait"] is None:
             raise ValueError(f"{path}: a Monte Carlo campaign needs a walking scenario (control.mode = \"gait\"), for the specific resistance")
         distributions = FrictionDistributions.of_robot(info["robot"])
@@ -122,7 +129,7 @@ class Campaign:
             )
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise ValueError(f"seed = {seed!r}: need an integer >= 0")
-        campaign = cls(path, info["name"], path.read_text(), velocities, runs, variants, seed, distributions)
+        campaign = cls(path, info["name"], info["text"], velocities, runs, variants, seed, distributions, fields)
         # The overrides must fit the scenario (a constant heading, ...): check one run of each
         # variant now rather than store every run as failed.
         for variant in variants:
@@ -145,6 +152,7 @@ class Campaign:
     def overrides(self, key: RunKey) -> dict[str, Any]:
         """The scenario overrides of a run."""
         return {
+            **self.fields,
             "scenario.name": f"{self.scenario_name}-{key.variant}-v{key.velocity_index}-r{key.run_index}",
             "model.friction": "dry_viscous",
             "model.load_dependence": VARIANTS[key.variant],

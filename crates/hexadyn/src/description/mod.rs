@@ -59,9 +59,12 @@ pub const PHANTOMX_TOML: &str = include_str!("../../../../robots/phantomx/phanto
 /// was embedded from (named in errors).
 pub const SHIPPED_ROBOTS: [(&str, &str, &str); 2] = [("amru5", AMRU5_TOML, AMRU5_ORIGIN), ("phantomx", PHANTOMX_TOML, "robots/phantomx/phantomx.toml")];
 
-/// Name used in error messages for the embedded file, and the reference for the required
-/// fields of any description.
+/// Name used in error messages for the embedded file.
 const AMRU5_ORIGIN: &str = "robots/amru5.toml";
+
+/// Where "missing field" errors of a pantograph description send the reader: a command every
+/// installation has (it prints the embedded file), not a path of the repository.
+const PANTOGRAPH_REFERENCE: &str = "`hexadyn robot-file amru5`, a complete description";
 
 impl RobotDescription {
     /// The shipped AMRU5 description (embedded `robots/amru5.toml`).
@@ -85,7 +88,7 @@ impl RobotDescription {
     /// Parses and validates a description; `origin_name` (a file name) is used in errors.
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(text: &str, origin_name: &str) -> Result<RobotDescription> {
-        let index = SpanIndex::build_for(text, origin_name, AMRU5_ORIGIN)?;
+        let index = SpanIndex::build_for(text, origin_name, PANTOGRAPH_REFERENCE)?;
         index.check_top_level(crate::fields::struct_fields::<RobotDescription>())?;
         let mut robot: RobotDescription = toml::from_str(text).map_err(|e| index.serde_error(&e))?;
         robot.origin = origin_name.to_string();

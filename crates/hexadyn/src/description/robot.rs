@@ -11,8 +11,9 @@ use crate::control::FrictionFeedForward;
 use crate::hexapod::{LegDynamics, LegJoints, PantographJoint, JOINTS};
 use crate::robot::model::{FrictionModel, ModelOptions, RobotParts};
 
-/// Where "missing field" errors of a serial description send the reader.
-const SERIAL_REFERENCE: &str = "docs/robot-format.md";
+/// Where "missing field" errors of a serial description send the reader (a command every
+/// installation has, and the format's documentation).
+const SERIAL_REFERENCE: &str = "`hexadyn robot-file phantomx`, a complete description, and docs/robot-format.md";
 
 /// A robot description: AMRU5's pantograph legs, or serial legs. (Read once per scenario and
 /// never moved in a loop: the variants' sizes do not matter.)

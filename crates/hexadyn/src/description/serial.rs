@@ -308,7 +308,7 @@ impl SerialRobot {
     /// Validates the file's tables (`c` names the file).
     pub(crate) fn validate(f: &SerialDescriptionFile, c: &Ctx) -> Result<SerialRobot> {
         if f.leg_mechanism != "serial" {
-            return Err(c.err("leg_mechanism", format!("{:?}", f.leg_mechanism), "not a serial description", "\"serial\" (or no leg_mechanism for a pantograph description like robots/amru5.toml)"));
+            return Err(c.err("leg_mechanism", format!("{:?}", f.leg_mechanism), "not a serial description", "\"serial\" (or no leg_mechanism for a pantograph description like `hexadyn robot-file amru5`)"));
         }
         if f.legs.len() != LEG_COUNT {
             return Err(c.err("legs", format!("{} legs", f.legs.len()), "not six legs", "six [[legs]], numbered 0, 2, 4 on the left from front to rear and 1, 3, 5 on the right"));
