@@ -310,8 +310,8 @@ def test_a_scenario_with_a_byte_order_mark_is_stored_and_reloaded(tmp_path: Path
 def test_compare_reads_the_velocity_through_the_engine(tmp_path: Path):
     path = tmp_path / "walk.toml"
     path.write_bytes(b"\xef\xbb\xbf" + (hexadyn.SCENARIOS_DIR / "validation_tripod_2cm.toml").read_bytes())
-    assert compare._scenario_velocity(path) == 0.02
-    assert compare._scenario_velocity(hexadyn.SCENARIOS_DIR / "path_spline.toml") is None
+    assert compare._scenario_velocity(path, {}) == 0.02
+    assert compare._scenario_velocity(hexadyn.SCENARIOS_DIR / "path_spline.toml", {}) is None
 
 
 def test_compare_friction_with_one_velocity_skips_the_fit(tmp_path: Path):
