@@ -42,7 +42,7 @@ def figures(spec: StudySpec, runs: pd.DataFrame, indices: pd.DataFrame | None) -
 
 def _response(spec: StudySpec, runs: pd.DataFrame, output: str) -> Figure:
     n = len(spec.parameters)
-    cols = min(n, 3)
+    cols = n if n <= 3 else math.ceil(math.sqrt(n))
     fig = Figure(figsize=(3.6 * cols, 3.0 * math.ceil(n / cols)), layout="constrained")
     axes = fig.subplots(math.ceil(n / cols), cols, squeeze=False, sharey=True).ravel()
     for ax, p in zip(axes, spec.parameters):
