@@ -19,7 +19,7 @@ import signal
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from typing import Any, Callable, Hashable, Iterable, Iterator, Mapping, Protocol, Sequence
+from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence
 
 from hexadyn.montecarlo.storage import summary_columns
 
@@ -78,7 +78,7 @@ class Executor(Protocol):
     """Runs ``function`` on the payload of each (key, payload) task, yielding (key, result) as
     they finish."""
 
-    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Iterator[tuple[Hashable, Any]]: ...
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]: ...
 
     def capped(self, tasks: int) -> Executor:
         """The same executor with no more workers than `tasks` (the tasks it is given)."""
@@ -98,7 +98,7 @@ class ProcessPool:
     def capped(self, tasks: int) -> ProcessPool:
         return ProcessPool(max(1, min(self.workers, tasks)))
 
-    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Iterator[tuple[Hashable, Any]]:
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]:
         executor = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker, initargs=(os.getpid(),))
         queue = iter(tasks)
         running: dict[Future, Hashable] = {}
@@ -166,7 +166,7 @@ class Ray:
             return self
         return Ray(self.address, max(1, min(self.workers or os.cpu_count() or 1, tasks)))
 
-    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Iterator[tuple[Hashable, Any]]:
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]:
         try:
             import ray
         except ImportError as exc:

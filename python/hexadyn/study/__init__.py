@@ -13,7 +13,20 @@ simulated and stored by :mod:`hexadyn.montecarlo`'s machinery), :mod:`~hexadyn.s
 (the indices), :mod:`~hexadyn.study.figures` and :mod:`~hexadyn.study.command` (the command).
 """
 
-from hexadyn.study.spec import Design, Parameter, StudySpec, parse_study, read_study
-from hexadyn.study.study import FunctionModel, ScenarioModel, Study, StudyResults, run_study
+import importlib
+from typing import Any
 
-__all__ = ["Design", "FunctionModel", "Parameter", "ScenarioModel", "Study", "StudyResults", "StudySpec", "parse_study", "read_study", "run_study"]
+#: The names of the package -> their module, imported on first use: `hexadyn --help` and the
+#: other commands do not pay for numpy and the Monte Carlo machinery.
+_EXPORTS = {
+    **dict.fromkeys(["Design", "Parameter", "StudySpec", "parse_study", "read_study"], "hexadyn.study.spec"),
+    **dict.fromkeys(["FunctionModel", "ScenarioModel", "Study", "StudyResults", "run_study"], "hexadyn.study.study"),
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'hexadyn.study' has no attribute {name!r}")
+    return getattr(importlib.import_module(_EXPORTS[name]), name)

@@ -16,7 +16,7 @@ and Morris' estimators need every run of their design.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -69,7 +69,7 @@ def second_order_indices(spec: StudySpec, runs: pd.DataFrame) -> pd.DataFrame | 
     return pd.DataFrame(rows, columns=SECOND_ORDER_COLUMNS)
 
 
-def _analyze(spec: StudySpec, runs: pd.DataFrame, output: str):
+def _analyze(spec: StudySpec, runs: pd.DataFrame, output: str) -> Any:
     """SALib's analysis of one output, or None if a run failed or a value is not finite."""
     y = runs[output].to_numpy(dtype=float)
     if (runs["status"] != "ok").any() or not np.isfinite(y).all():

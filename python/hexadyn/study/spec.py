@@ -18,7 +18,7 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, NoReturn
 
 __all__ = ["DISTRIBUTIONS", "METHODS", "Design", "Parameter", "StudySpec", "parse_study", "read_study"]
 
@@ -68,7 +68,7 @@ class Parameter:
     def salib(self) -> tuple[str, list[float]]:
         """SALib's distribution name and its ``bounds`` entry."""
         assert self.distribution is not None
-        numbers = {"range": list(self.range or ()), "mean": [self.mean], "std": [self.std]}
+        numbers: dict[str, list[Any]] = {"range": list(self.range or ()), "mean": [self.mean], "std": [self.std]}
         return _SALIB_DISTRIBUTIONS[self.distribution], [x for k in DISTRIBUTIONS[self.distribution] for x in numbers[k]]
 
     def grid(self, levels: int) -> tuple[float, ...]:
@@ -204,7 +204,7 @@ def run_count(spec: StudySpec) -> int:
 
 def _design(check: _Checker, table: Mapping[str, Any]) -> Design:
     method = table.get("method")
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         check.bad("design.method", method, f"one of {', '.join(METHODS)}")
     taken = DESIGN_KEYS[method]
     check.keys("design", table, ("method", *taken), required=tuple(k for k, v in taken.items() if v is None and k == "samples"))
@@ -279,7 +279,7 @@ class _Checker:
     def __init__(self, source: str) -> None:
         self.source = source
 
-    def bad(self, field: str, value: Any, allowed: str) -> Any:
+    def bad(self, field: str, value: Any, allowed: str) -> NoReturn:
         shown = json.dumps(value, default=str, ensure_ascii=False)
         raise ValueError(f"{self.source}: field `{field}` = {shown if len(shown) <= 80 else shown[:77] + '...'}: allowed: {allowed}")
 

@@ -20,7 +20,7 @@ import os
 from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -32,6 +32,9 @@ from hexadyn.montecarlo.execution import SERIES_FIGURES, Executor, ProcessPool, 
 from hexadyn.montecarlo.storage import Layout, RunStore
 from hexadyn.study import analysis, design
 from hexadyn.study.spec import StudySpec, read_study
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["FORMAT", "RUNS_FILE", "STUDY_FILE", "FunctionModel", "ScenarioModel", "Study", "StudyResults", "run_study"]
 
@@ -92,13 +95,13 @@ class StudyResults:
     and ``second_order`` (:func:`analysis.second_order_indices`), None where the design gives
     none, and the study ``folder``."""
 
-    runs: Any
-    indices: Any
-    second_order: Any
+    runs: pd.DataFrame
+    indices: pd.DataFrame | None
+    second_order: pd.DataFrame | None
     folder: Path
 
     @property
-    def failures(self):
+    def failures(self) -> pd.DataFrame:
         """The failed runs: ``run_index`` and ``error``."""
         return self.runs.loc[self.runs["status"] != "ok", ["run_index", "error"]].reset_index(drop=True)
 
