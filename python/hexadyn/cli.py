@@ -524,5 +524,9 @@ from hexadyn.identify.command import identify_command  # noqa: E402  (hexadyn id
 
 cli.add_command(identify_command)
 
+from hexadyn.study.command import study_command  # noqa: E402  (hexadyn study: design studies)
+
+cli.add_command(study_command)
+
 if __name__ == "__main__":  # pragma: no cover
     main()

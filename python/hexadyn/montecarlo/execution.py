@@ -1,12 +1,14 @@
-"""Running the simulations of a campaign: on the local cores (a process pool) or on Ray.
+"""Running the simulations of a campaign or a design study: on the local cores (a process
+pool) or on Ray.
 
-Both executors take (key, overrides) tasks and yield (key, outcome) as the simulations finish,
-in any order; the caller (the parent process, or the Ray driver) stores the outcomes. An
-outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
-:func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints) or ``{"status": "failed", "error":
-message}`` for a simulation the engine rejected (ValueError); any other exception stops the
-campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the tasks not
-finished yet and stops the workers.
+Both executors take a picklable function and (key, payload) tasks, and yield (key,
+``function(payload)``) as the tasks finish, in any order; the caller (the parent process, or the
+Ray driver) stores the results. A Monte Carlo campaign's function is :func:`simulate_run` of its
+scenario, whose outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
+:func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints) or ``{"status":
+"failed", "error": message}`` for a simulation the engine rejected (ValueError); any exception
+stops the campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the
+tasks not finished yet and stops the workers.
 """
 
 from __future__ import annotations
@@ -17,13 +19,18 @@ import signal
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from typing import Any, Iterable, Iterator, Mapping, Protocol
+from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence
 
-from hexadyn.montecarlo.storage import RunKey, summary_columns
+from hexadyn.montecarlo.storage import summary_columns
 
-__all__ = ["Executor", "ProcessPool", "Ray", "simulate_run"]
+__all__ = ["SERIES_FIGURES", "Executor", "ProcessPool", "Ray", "simulate_run"]
 
-Task = tuple[RunKey, Mapping[str, Any]]
+#: A task: its key (handed back with its result) and the argument of the executor's function.
+Task = tuple[Hashable, Any]
+
+#: The figures of a run's summary that :func:`hexadyn.energy.add_energy_figures` computes from
+#: the time series (:func:`hexadyn.simulate` adds them; the engine's summary has the others).
+SERIES_FIGURES = ("energy_mechanical_j", "friction_share", "joule_share")
 
 #: Tasks submitted ahead per worker process or CPU of the Ray cluster (one running, one queued
 #: to start at once): the tasks of a campaign, up to a million, are not all held at a time.
@@ -35,37 +42,43 @@ IN_FLIGHT_PER_CPU = 2
 WALKS_PER_TASK = 4
 
 
-def simulate_run(scenario: str, overrides: Mapping[str, Any]) -> dict[str, Any]:
-    """Runs one simulation (summary only) and returns its outcome: the
-    :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints (the split of E
-    per joint under the robot's joint names)."""
+def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[str] | None = None) -> dict[str, Any]:
+    """Runs one simulation and returns its outcome: the summary ``entries`` (default: the
+    :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints, the split of E
+    per joint under the robot's joint names). The engine's summary alone (no time series)
+    unless an entry is one of :data:`SERIES_FIGURES`: then the run is :func:`hexadyn.simulate`'s,
+    series in memory. An entry the summary lacks is None."""
     from hexadyn import _core
     from hexadyn.vocabulary import Joints
 
     try:
-        raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
+        if entries is not None and any(e in SERIES_FIGURES for e in entries):
+            from hexadyn.runner import simulate
+
+            summary = simulate(scenario, progress=False, overrides=overrides).summary
+        else:
+            raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
+            summary = raw["summary"]
+            entries = summary_columns(Joints.of_robot(raw["robot"]).names) if entries is None else entries
     except ValueError as exc:
         return {"status": "failed", "error": " ".join(str(exc).split())}
-    summary = raw["summary"]
-    names = Joints.of_robot(raw["robot"]).names
-    return {"status": "ok", "summary": {c: summary[c] for c in summary_columns(names)}}
+    return {"status": "ok", "summary": {c: summary.get(c) for c in entries}}
 
 
-def _several(run_one):
-    """A task of several walks: ``run_one`` (:func:`simulate_run` as the module holds it when
-    the campaign starts, so that a benchmark's timed replacement is what the workers call) of
-    each overrides, in order."""
+def _several(function: Callable[[Any], Any]) -> Callable[[list[Any]], list[Any]]:
+    """A task of several payloads: ``function`` of each, in order."""
 
-    def run(scenario: str, overrides: list[Mapping[str, Any]]) -> list[dict[str, Any]]:
-        return [run_one(scenario, o) for o in overrides]
+    def run(payloads: list[Any]) -> list[Any]:
+        return [function(p) for p in payloads]
 
     return run
 
 
 class Executor(Protocol):
-    """Runs (key, overrides) tasks of a scenario, yielding (key, outcome) as they finish."""
+    """Runs ``function`` on the payload of each (key, payload) task, yielding (key, result) as
+    they finish."""
 
-    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]: ...
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]: ...
 
     def capped(self, tasks: int) -> Executor:
         """The same executor with no more workers than `tasks` (the tasks it is given)."""
@@ -85,14 +98,14 @@ class ProcessPool:
     def capped(self, tasks: int) -> ProcessPool:
         return ProcessPool(max(1, min(self.workers, tasks)))
 
-    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]:
         executor = ProcessPoolExecutor(max_workers=self.workers, initializer=_init_worker, initargs=(os.getpid(),))
         queue = iter(tasks)
-        running: dict[Future, RunKey] = {}
+        running: dict[Future, Hashable] = {}
 
         def submit(count: int) -> None:
-            for key, overrides in itertools.islice(queue, count):
-                running[executor.submit(simulate_run, scenario, overrides)] = key
+            for key, payload in itertools.islice(queue, count):
+                running[executor.submit(function, payload)] = key
 
         try:
             submit(IN_FLIGHT_PER_CPU * self.workers)
@@ -153,7 +166,7 @@ class Ray:
             return self
         return Ray(self.address, max(1, min(self.workers or os.cpu_count() or 1, tasks)))
 
-    def run(self, scenario: str, tasks: Iterable[Task]) -> Iterator[tuple[RunKey, dict[str, Any]]]:
+    def run(self, function: Callable[[Any], Any], tasks: Iterable[Task]) -> Generator[tuple[Hashable, Any], None, None]:
         try:
             import ray
         except ImportError as exc:
@@ -165,21 +178,21 @@ class Ray:
                 ray.init(num_cpus=self.workers, include_dashboard=False, log_to_driver=False)
             else:
                 ray.init(address=self.address, log_to_driver=False)
-        remote = ray.remote(num_cpus=1)(_several(simulate_run))
+        remote = ray.remote(num_cpus=1)(_several(function))
         # At most IN_FLIGHT_PER_CPU tasks (of WALKS_PER_TASK walks) per CPU of the cluster are
         # submitted at a time, a new one as each finishes: the driver's ray.wait then looks at a
         # few refs, not at the whole campaign (1.3 ms per call over 2000 refs, for each of
         # thousands of walks).
         in_flight = max(1, int(IN_FLIGHT_PER_CPU * ray.cluster_resources().get("CPU", 1)))
         queue = iter(tasks)
-        refs: dict[Any, list[RunKey]] = {}
+        refs: dict[Any, list[Hashable]] = {}
 
         def submit(count: int) -> None:
             for _ in range(count):
                 batch = list(itertools.islice(queue, WALKS_PER_TASK))
                 if not batch:
                     return
-                refs[remote.remote(scenario, [dict(overrides) for _, overrides in batch])] = [key for key, _ in batch]
+                refs[remote.remote([payload for _, payload in batch])] = [key for key, _ in batch]
 
         try:
             submit(in_flight)

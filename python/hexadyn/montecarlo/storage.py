@@ -1,5 +1,8 @@
 """The campaign folder: ``campaign.json`` (the configuration) and ``runs.sqlite`` (the runs).
 
+:class:`RunStore` keeps such a folder for any :class:`Layout` of runs (a design study's too,
+:mod:`hexadyn.study`); :class:`CampaignStore` is a campaign's.
+
 ``campaign.json`` holds the configuration of the campaign (scenario text, velocities, runs,
 variants, seed, distributions) and the hexadyn version; a folder is resumed only with the same
 configuration. ``runs.sqlite`` has one row per finished simulation in the table ``runs``, keyed
@@ -20,12 +23,13 @@ import json
 import os
 import sqlite3
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping, NamedTuple, Sequence
 
 from hexadyn import atomic
 
-__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "RunKey", "per_joint_columns", "summary_columns"]
+__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "Layout", "RunKey", "RunStore", "campaign_layout", "per_joint_columns", "summary_columns"]
 
 CAMPAIGN_FILE = "campaign.json"
 DATABASE_FILE = "runs.sqlite"
@@ -68,20 +72,38 @@ PER_JOINT_COLUMNS = per_joint_columns()
 SUMMARY_COLUMNS = summary_columns()
 
 
-def _schema(columns: Sequence[str]) -> str:
-    return f"""
-CREATE TABLE IF NOT EXISTS runs (
-    variant TEXT NOT NULL,
-    velocity_index INTEGER NOT NULL,
-    run_index INTEGER NOT NULL,
-    velocity_m_s REAL NOT NULL,
-    status TEXT NOT NULL CHECK (status IN ('ok', 'failed')),
-    error TEXT,
-    parameters TEXT NOT NULL,
-    {", ".join(f"{c} REAL" for c in columns)},
-    PRIMARY KEY (variant, velocity_index, run_index)
-)
-"""
+@dataclass(frozen=True)
+class Layout:
+    """What a folder of runs holds: ``config_file`` (its configuration, ``{"format": format,
+    "configuration": {...}}``) and the table ``runs`` of :data:`DATABASE_FILE`, keyed by the
+    ``keys`` columns, with the ``columns`` besides (name -> SQL type: INTEGER, REAL, TEXT).
+    ``what`` names such a folder in messages ("Monte Carlo campaign", "design study")."""
+
+    what: str
+    format: str
+    config_file: str
+    keys: Mapping[str, str]
+    columns: Mapping[str, str]
+
+    def schema(self) -> str:
+        columns = [f"{_quoted(c)} {t} NOT NULL" for c, t in self.keys.items()]
+        columns += [f"{_quoted(c)} {t}" for c, t in self.columns.items()]
+        columns[len(self.keys) :] = ["status TEXT NOT NULL CHECK (status IN ('ok', 'failed'))", "error TEXT", *columns[len(self.keys) :]]
+        return f"CREATE TABLE IF NOT EXISTS runs ({', '.join(columns)}, PRIMARY KEY ({', '.join(map(_quoted, self.keys))}))"
+
+
+def _quoted(name: str) -> str:
+    """A column name in SQL: a plain identifier as it is (SQLite would take a quoted name that
+    is no column for a string), a dotted scenario field quoted (``"gait.period_s"``)."""
+    return name if name.isidentifier() else '"' + name.replace('"', '""') + '"'
+
+
+def campaign_layout(joints: Sequence[str] = AMRU5_JOINTS) -> Layout:
+    """A Monte Carlo campaign's folder: runs keyed by (variant, velocity_index, run_index), with
+    the velocity, the drawn friction (JSON) and the :func:`summary_columns` of the robot's joints."""
+    keys = {"variant": "TEXT", "velocity_index": "INTEGER", "run_index": "INTEGER"}
+    columns = {"velocity_m_s": "REAL NOT NULL", "parameters": "TEXT NOT NULL", **{c: "REAL" for c in summary_columns(joints)}}
+    return Layout("Monte Carlo campaign", FORMAT, CAMPAIGN_FILE, keys, columns)
 
 
 class RunKey(NamedTuple):
@@ -92,55 +114,93 @@ class RunKey(NamedTuple):
     run_index: int
 
 
-class CampaignStore:
-    """A campaign folder, created or reopened with :meth:`open`."""
+class RunStore:
+    """A folder of runs (a campaign's, a study's), created or reopened with :meth:`open`."""
 
-    def __init__(self, folder: Path, connection: sqlite3.Connection, joints: Sequence[str] = AMRU5_JOINTS) -> None:
+    def __init__(self, folder: Path, connection: sqlite3.Connection, layout: Layout) -> None:
         self.folder = folder
         self._db = connection
-        self.columns = summary_columns(joints)
+        self.layout = layout
 
     @classmethod
-    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any], joints: Sequence[str] = AMRU5_JOINTS) -> CampaignStore:
+    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any], layout: Layout):
+        """Creates the folder, or reopens it if it holds the same configuration.
+
+        Raises ValueError if ``folder`` holds something else than such a folder, or one with
+        another configuration (naming the first differing field).
+        """
+        folder = Path(folder)
+        config_file = folder / layout.config_file
+        if config_file.is_file():
+            _check_same_configuration(config_file, configuration, layout)
+        elif folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+            raise ValueError(f"{folder}: not a {layout.what} folder (no {layout.config_file}); choose an empty or new folder")
+        else:
+            folder.mkdir(parents=True, exist_ok=True)
+            text = json.dumps({"format": layout.format, "configuration": dict(configuration)}, indent=2) + "\n"
+            atomic.write_file(config_file, lambda tmp: tmp.write_text(text))
+        connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
+        try:
+            with _readable(folder / DATABASE_FILE, layout), connection:
+                connection.execute(layout.schema())
+        except BaseException:
+            connection.close()
+            raise
+        return cls(folder, connection, layout)
+
+    def close(self) -> None:
+        self._db.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def finished(self) -> set[tuple]:
+        """The keys of the runs stored so far (succeeded or failed)."""
+        with _readable(self.folder / DATABASE_FILE, self.layout):
+            return set(self._db.execute(f"SELECT {', '.join(map(_quoted, self.layout.keys))} FROM runs"))
+
+    def add_rows(self, rows: Sequence[Mapping[str, Any]]) -> None:
+        """Stores finished runs in one transaction: each row maps the key columns, ``status``
+        (``ok`` or ``failed``), ``error`` and any of the other columns (missing: NULL). A run
+        already stored is an error (sqlite3.IntegrityError)."""
+        columns = (*self.layout.keys, "status", "error", *self.layout.columns)
+        statement = f"INSERT INTO runs ({', '.join(map(_quoted, columns))}) VALUES ({', '.join('?' * len(columns))})"
+        with _readable(self.folder / DATABASE_FILE, self.layout), self._db:
+            self._db.executemany(statement, [tuple(row.get(c) for c in columns) for row in rows])
+
+    def runs(self):
+        """Every stored run as a pandas DataFrame sorted by its key (the order makes aggregates
+        independent of the order the runs finished in)."""
+        import pandas as pd
+
+        with _readable(self.folder / DATABASE_FILE, self.layout, pd.errors.DatabaseError):
+            return pd.read_sql_query(f"SELECT * FROM runs ORDER BY {', '.join(map(_quoted, self.layout.keys))}", self._db)
+
+
+class CampaignStore(RunStore):
+    """A campaign folder, created or reopened with :meth:`open`."""
+
+    @classmethod
+    def open(cls, folder: str | os.PathLike, configuration: Mapping[str, Any], joints: Sequence[str] = AMRU5_JOINTS) -> CampaignStore:  # type: ignore[override]
         """Creates the campaign folder, or reopens it if it holds the same configuration.
         ``joints``: the robot's joint names, for the per-joint columns.
 
         Raises ValueError if ``folder`` holds something else than a campaign, or a campaign
         with another configuration (naming the first differing field).
         """
-        folder = Path(folder)
-        config_file = folder / CAMPAIGN_FILE
-        if config_file.is_file():
-            _check_same_configuration(config_file, configuration)
-        elif folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-            raise ValueError(f"{folder}: not a Monte Carlo campaign folder (no {CAMPAIGN_FILE}); choose an empty or new folder")
-        else:
-            folder.mkdir(parents=True, exist_ok=True)
-            text = json.dumps({"format": FORMAT, "configuration": dict(configuration)}, indent=2) + "\n"
-            atomic.write_file(config_file, lambda tmp: tmp.write_text(text))
-        connection = sqlite3.connect(folder / DATABASE_FILE, timeout=60.0)
-        try:
-            with _readable(folder / DATABASE_FILE), connection:
-                connection.execute(_schema(summary_columns(joints)))
-        except BaseException:
-            connection.close()
-            raise
-        return cls(folder, connection, joints)
+        return super().open(folder, configuration, campaign_layout(joints))
 
-    def close(self) -> None:
-        self._db.close()
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The summary columns of the runs."""
+        return tuple(self.layout.columns)[2:]
 
-    def __enter__(self) -> CampaignStore:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def finished(self) -> set[RunKey]:
+    def finished(self) -> set[RunKey]:  # type: ignore[override]
         """The runs stored so far (succeeded or failed)."""
-        with _readable(self.folder / DATABASE_FILE):
-            rows = self._db.execute("SELECT variant, velocity_index, run_index FROM runs")
-            return {RunKey(*row) for row in rows}
+        return {RunKey(*key) for key in super().finished()}
 
     def add(self, key: RunKey, velocity_m_s: float, parameters: Mapping[str, Any], outcome: Mapping[str, Any]) -> None:
         """Stores one finished run in its own transaction.
@@ -148,23 +208,12 @@ class CampaignStore:
         ``outcome`` is ``{"status": "ok", "summary": {...}}`` or ``{"status": "failed",
         "error": message}``. A run already stored is an error (sqlite3.IntegrityError).
         """
-        summary = outcome.get("summary", {})
-        columns = ("variant", "velocity_index", "run_index", "velocity_m_s", "status", "error", "parameters", *self.columns)
-        values = (*key, velocity_m_s, outcome["status"], outcome.get("error"), json.dumps(dict(parameters)), *(summary.get(c) for c in self.columns))
-        with _readable(self.folder / DATABASE_FILE), self._db:
-            self._db.execute(f"INSERT INTO runs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})", values)
-
-    def runs(self):
-        """Every stored run as a pandas DataFrame sorted by (variant, velocity_index, run_index)
-        (the order makes aggregates independent of the order the runs finished in)."""
-        import pandas as pd
-
-        with _readable(self.folder / DATABASE_FILE, pd.errors.DatabaseError):
-            return pd.read_sql_query("SELECT * FROM runs ORDER BY variant, velocity_index, run_index", self._db)
+        row = {**outcome.get("summary", {}), **key._asdict(), "velocity_m_s": velocity_m_s, "parameters": json.dumps(dict(parameters))}
+        self.add_rows([{**row, "status": outcome["status"], "error": outcome.get("error")}])
 
 
 @contextmanager
-def _readable(database: Path, *wrapped: type[Exception]):
+def _readable(database: Path, layout: Layout, *wrapped: type[Exception]):
     """Turns an error of the SQLite file `database` (truncated, not a database, another table,
     locked beyond the timeout) into a ValueError of one line naming it; `wrapped`: the errors a
     reader wraps SQLite's in (pandas'). A run stored twice (sqlite3.IntegrityError) is a bug,
@@ -175,23 +224,25 @@ def _readable(database: Path, *wrapped: type[Exception]):
         raise
     except (sqlite3.DatabaseError, *wrapped) as exc:
         cause = exc.__cause__ if isinstance(exc.__cause__, sqlite3.Error) else exc
-        raise ValueError(f"{database}: not a readable campaign database ({' '.join(str(cause).split())}); restore it, or move it away to start the campaign again") from exc
+        noun = layout.what.split()[-1]  # campaign, study
+        raise ValueError(f"{database}: not a readable {noun} database ({' '.join(str(cause).split())}); restore it, or move it away to start the {noun} again") from exc
 
 
-def _check_same_configuration(config_file: Path, configuration: Mapping[str, Any]) -> None:
+def _check_same_configuration(config_file: Path, configuration: Mapping[str, Any], layout: Layout) -> None:
+    noun = layout.what.split()[-1]
     try:
         stored = json.loads(config_file.read_text())
     except ValueError as exc:
-        raise ValueError(f"{config_file}: not a campaign file ({exc})") from exc
-    if not isinstance(stored, dict) or stored.get("format") != FORMAT:
-        raise ValueError(f"{config_file}: not a hexadyn Monte Carlo campaign file")
+        raise ValueError(f"{config_file}: not a {noun} file ({exc})") from exc
+    if not isinstance(stored, dict) or stored.get("format") != layout.format:
+        raise ValueError(f"{config_file}: not a hexadyn {layout.what} file")
     # JSON round trip: tuples become lists, as in the stored file.
     wanted = json.loads(json.dumps(dict(configuration)))
     old = stored.get("configuration", {})
     for field in sorted(set(wanted) | set(old)):
         if wanted.get(field) != old.get(field):
             raise ValueError(
-                f"{config_file.parent}: the campaign there has another {field} "
+                f"{config_file.parent}: the {noun} there has another {field} "
                 f"({_short(old.get(field))} there, {_short(wanted.get(field))} now); "
                 "rerun with its configuration to resume it, or choose another folder"
             )
