@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 import os
 import re
 import shlex
@@ -24,6 +25,7 @@ import tomllib
 from pathlib import Path
 
 import matplotlib
+import pandas as pd
 import pytest
 from click.testing import CliRunner
 from docs_blocks import LANGUAGES, PAGES, ROOT, Block, blocks, prose
@@ -56,6 +58,23 @@ def test_the_page_runs_as_written(page: str, tmp_path: Path, monkeypatch: pytest
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(ROOT / source, target)
         run_block(block, tmp_path, namespace)
+    if check := AFTER_PAGE.get(page):
+        check(tmp_path)
+
+
+def the_walk_through_walks(folder: Path) -> None:
+    """docs/add-your-robot.md ends with a walk of the imported robot: it walks."""
+    summary = json.loads((folder / "results" / "my_tripod" / "summary.json").read_text())
+    assert summary["clamped_ik_references"] == 0
+    assert summary["reference_distance_m"] > 0.39 and summary["distance_walked_m"] > 0.7 * summary["reference_distance_m"]
+    assert abs(summary["energy_balance_error_relative"]) < 1e-3
+    columns = pd.read_parquet(folder / "results" / "my_tripod" / "timeseries.parquet", columns=["hip[0]", "thigh[5]", "shank[3]"])
+    assert len(columns) == 1001
+    assert (folder / "my_hexapod_out.urdf").read_text().startswith("<?xml")
+
+
+#: What a page's run must have produced, beyond every command succeeding.
+AFTER_PAGE = {"docs/add-your-robot.md": the_walk_through_walks}
 
 
 def run_block(block: Block, folder: Path, namespace: dict[str, object]) -> None:
@@ -127,32 +146,39 @@ def test_no_placeholder_is_left(page: str) -> None:
         assert not PLACEHOLDER.search(line), f"{page}:{number}: placeholder: {line.strip()}"
 
 
-#: What makes a paragraph a measured figure: wall or CPU time, a rate, a load, a screenshot.
-MEASURED = re.compile(r"load average|\bwall\b|\bCPU\b|real-time factor|frames/s|simulations/s|µs|\bMeasured\b|\bmeasured (on|at|with|in)\b|!\[")
+#: What makes a paragraph a measured figure: a time of wall clock, CPU or user, a rate of
+#: frames or simulations, a load average or real-time factor with its number, a paragraph that
+#: says "Measured", a screenshot.
+MEASURED = re.compile(
+    r"\d\s*(?:s|ms|µs|min)\b[^.;]{0,25}\b(?:wall|CPU|user)\b|\b(?:wall|CPU|user) time[^.;]{0,15}\d"
+    r"|\d\s*(?:frames|simulations)/s|load average \d|real-time factor \d|\bMeasured\b|!\["
+)
 DATE = re.compile(r"\b20\d\d-\d\d-\d\d\b")
 COMMIT = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
 MACHINE = re.compile(r"\b\d+[- ]cores?\b")
 
 
 def figure_paragraphs(page: str) -> list[tuple[str, str]]:
-    """The paragraphs of `page` that give a measured figure, each with the heading of its
-    section (a stamp there covers the section's figures)."""
+    """The paragraphs of `page` that give a measured figure, each with where its stamp may
+    also be: the heading of its section (a stamp there covers the section) and the paragraph
+    before it (the sentence that introduces a table or a list)."""
     out = []
-    heading = ""
+    heading = previous = ""
     for paragraph in re.split(r"\n\s*\n", prose(page)):
         if paragraph.lstrip().startswith("#"):
-            heading = paragraph.strip().splitlines()[0]
+            heading, previous = paragraph.strip().splitlines()[0], ""
             continue
         if MEASURED.search(paragraph):
-            out.append((heading, paragraph.strip()))
+            out.append((heading + "\n" + previous, paragraph.strip()))
+        previous = paragraph
     return out
 
 
 @pytest.mark.parametrize("page", PAGES)
 def test_measured_figures_carry_their_date_machine_and_commit(page: str) -> None:
     missing = []
-    for heading, paragraph in figure_paragraphs(page):
-        lacks = [what for what, stamp in (("date", DATE), ("machine (N-core)", MACHINE), ("commit", COMMIT)) if not (stamp.search(paragraph) or stamp.search(heading))]
+    for around, paragraph in figure_paragraphs(page):
+        lacks = [what for what, stamp in (("date", DATE), ("machine (N-core)", MACHINE), ("commit", COMMIT)) if not (stamp.search(paragraph) or stamp.search(around))]
         if lacks:
             missing.append(f"{', '.join(lacks)}: {paragraph[:100]!r}")
     assert not missing, f"{page}: figures without " + "\n".join(missing)
