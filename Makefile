@@ -17,11 +17,12 @@ RUST_SOURCES := Cargo.toml Cargo.lock $(shell find crates -name '*.rs' -o -name 
 DEPS_STAMP := $(VENV)/.hexadyn-deps
 BUILD_STAMP := $(VENV)/.hexadyn-build
 
-.PHONY: help setup chromium run test lint test-rust test-python bench bench-peer bench-urdf bench-montecarlo terrains lock clean
+.PHONY: help setup chromium run test docs lint test-rust test-python bench bench-peer bench-urdf bench-montecarlo terrains lock clean
 
 help:
 	@echo "make run    set everything up, then run hexadyn on the default scenario"
 	@echo "make test   set everything up, then run clippy and the Rust and Python tests"
+	@echo "make docs   build the documentation site into site/ (mkdocs-material, warnings as errors)"
 	@echo "make lint   clippy on every crate and target, warnings as errors"
 	@echo "make setup  create .venv, install pinned dependencies, build the engine (release)"
 	@echo "make bench  run the engine benchmarks (release)"
@@ -58,6 +59,12 @@ run: setup
 	$(VENV)/bin/hexadyn simulate
 
 test: setup chromium lint test-rust test-python
+
+# The documentation site (mkdocs.yml over docs/): the `docs` extra, part of the `test` extra that
+# setup installs. --strict: a broken link or any other warning fails the build, as it fails
+# tests/python/test_docs.py.
+docs: setup
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
 
 # Clippy with the workspace's lint settings (Cargo.toml [workspace.lints]); rustup adds the
 # component where it is missing.

@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import importlib.util
 import os
-import re
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 import pytest
+from docs_blocks import PAGES, blocks
 
 import hexadyn
 
@@ -86,14 +86,19 @@ def test_a_users_script_type_checks_against_the_package(mypy, tmp_path: Path):
     assert out.returncode == 0, out.stdout + out.stderr
 
 
-def test_the_readme_python_examples_use_the_real_api(mypy, tmp_path: Path):
-    """The README's Python blocks, one script in their order (a block may use an earlier one's
-    names), against the package's types; names a block leaves to the reader (``target``) aside."""
-    blocks = re.findall(r"^```python\n(.*?)^```", (ROOT / "README.md").read_text(), re.M | re.S)
-    assert len(blocks) >= 4 and any("hexadyn.Scenario.load" in b for b in blocks)
-    script = tmp_path / "readme.py"
-    script.write_text("\n".join(blocks))
-    out = mypy("mypy", "--disable-error-code=name-defined", str(script), cwd=tmp_path)
+def test_the_documented_python_examples_use_the_real_api(mypy, tmp_path: Path):
+    """The Python blocks of the README and of docs/*.md, one script per page in their order (a
+    block may use an earlier one's names, as tests/python/test_docs.py runs them), against the
+    package's types."""
+    scripts = []
+    for page in PAGES:
+        code = [block.body for block in blocks(page) if block.language == "python" and block.marker("no-run") is None]
+        if code:
+            script = tmp_path / (page.replace("/", "_").replace("-", "_").removesuffix(".md") + ".py")
+            script.write_text("\n".join(code))
+            scripts.append(str(script))
+    assert len(scripts) >= 4 and any("hexadyn.Scenario.load" in Path(s).read_text() for s in scripts)
+    out = mypy("mypy", *scripts, cwd=tmp_path)
     assert out.returncode == 0, out.stdout + out.stderr
 
 
