@@ -114,9 +114,9 @@ def test_a_named_pipe_named_by_a_scenario_is_refused(tmp_path: Path, fifo: Path,
 def test_a_named_pipe_as_a_link_configuration_or_robot_file_is_refused(tmp_path: Path, fifo: Path):
     refused(run("robot", "run", "stand_six_legs", "--link", str(fifo), "--no-progress"), *pipe_refusal(fifo))
     refused(run("urdf", str(fifo)), *pipe_refusal(fifo))
-    refused(run("export-urdf", str(fifo), str(tmp_path / "out.urdf")), *pipe_refusal(fifo))
+    refused(run("export-urdf", str(fifo), "--out", str(tmp_path / "out.urdf")), *pipe_refusal(fifo))
     urdf = tmp_path / "robot.urdf"
-    run("export-urdf", "phantomx", str(urdf))
+    run("export-urdf", "phantomx", "--out", str(urdf))
     refused(run("import-urdf", str(urdf), "--out", str(tmp_path / "r.toml"), "--drives", str(fifo)), *pipe_refusal(fifo))
 
 
