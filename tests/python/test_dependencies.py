@@ -84,8 +84,8 @@ def test_extras_exist_and_the_test_extra_installs_the_optional_features():
     runtime, extras = declared()
     assert set(OPTIONAL.values()) <= set(extras)
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    # The tests exercise the view and Ray: the test extra pulls in both extras.
-    assert "hexadyn[ray,view]" in project["optional-dependencies"]["test"]
+    # The tests exercise the view, Ray and the docs site: the test extra pulls in those extras.
+    assert "hexadyn[ray,view,docs]" in project["optional-dependencies"]["test"]
     # `--ray ray://head:10001` (README) connects through Ray's client.
     assert "ray[client]" in project["optional-dependencies"]["ray"]
 

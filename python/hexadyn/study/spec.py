@@ -140,7 +140,7 @@ def read_study(path: str | os.PathLike) -> StudySpec:
 
     path = Path(path)
     try:
-        table = tomllib.loads(inputs.read_text(path, "study file"))
+        table = tomllib.loads(inputs.read_text(path))
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: not a TOML study file: {exc}") from exc
     return parse_study(table, os.fspath(path), name=path.stem, folder=path.parent)
