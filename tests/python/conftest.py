@@ -24,6 +24,17 @@ def sigint_as_in_a_terminal() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+def assert_one_line_error(result, *words: str) -> str:
+    """A CLI result (click's CliRunner) of a refused command: exit status 1 and one line
+    `Error: ...` on stderr holding each of `words`, no traceback; returns the line."""
+    assert result.exit_code == 1, (result.exit_code, result.output, result.exception)
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    return lines[0]
+
+
 def shortened(name: str, folder: Path, duration: float = 0.2) -> Path:
     """A copy of a shipped scenario with duration_s replaced (keeps the tests fast)."""
     text = (hexadyn.SCENARIOS_DIR / f"{name}.toml").read_text()

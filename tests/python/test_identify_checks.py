@@ -24,6 +24,7 @@ from hexadyn.cli import cli
 from hexadyn.identify import IdentifyError, identify, load_log
 from hexadyn.identify.checks import CURRENT_LIMIT_STALLS, STEP_TOLERANCE, check_friction_sign
 from hexadyn.identify.torques import leg_model
+from conftest import assert_one_line_error
 
 
 @pytest.fixture(scope="module")
@@ -34,16 +35,6 @@ def frame() -> pd.DataFrame:
 
 def invoke(*args: str):
     return CliRunner().invoke(cli, ["identify", *args])
-
-
-def assert_one_line_error(result, *words: str) -> str:
-    """Exit status 1 and one line `Error: ...` holding `words`, no traceback."""
-    assert result.exit_code == 1, (result.exit_code, result.output, result.exception)
-    lines = result.output.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
-    for w in words:
-        assert w in lines[0], (w, lines[0])
-    return lines[0]
 
 
 def test_a_clean_log_gives_the_robot_friction(frame, tmp_path):

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-from conftest import shortened
+from conftest import assert_one_line_error, shortened
 from scipy import stats
 
 from hexadyn import atomic
@@ -47,15 +47,6 @@ def finished(scenario, tmp_path_factory) -> Path:
 
 def invoke(*args: str):
     return CliRunner().invoke(cli, ["montecarlo", *args])
-
-
-def assert_one_line_error(result, *words: str) -> str:
-    assert result.exit_code == 1, (result.exit_code, result.output, result.exception)
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
-    for w in words:
-        assert w in lines[0], (w, lines[0])
-    return lines[0]
 
 
 def stats_file(folder: Path, entries: str) -> Path:

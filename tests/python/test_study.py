@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-from conftest import sigint_as_in_a_terminal
+from conftest import assert_one_line_error, sigint_as_in_a_terminal
 
 import hexadyn
 from hexadyn.cli import cli
@@ -238,15 +238,6 @@ def test_shipped_study_is_valid():
 # ----------------------------------------------------------------------------------------------
 # Validation: one line naming the file, the field, the value and what is allowed
 # ----------------------------------------------------------------------------------------------
-
-
-def assert_one_line_error(result, *words: str) -> str:
-    assert result.exit_code == 1, (result.exit_code, result.output, result.exception)
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.stderr
-    for w in words:
-        assert w in lines[0], (w, lines[0])
-    return lines[0]
 
 
 @pytest.mark.parametrize(
