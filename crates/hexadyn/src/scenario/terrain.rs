@@ -107,11 +107,11 @@ pub(super) fn validate(raw: Option<&RawTerrain>, c: &Ctx, dir: &Path) -> Result<
     })
 }
 
-/// The file of a mesh terrain, as the scenario resolves it (relative to the scenario's folder).
+/// The file of a mesh terrain, as the scenario resolves it (relative to the scenario's folder;
+/// `Path::join` keeps an absolute path as it is).
 pub(super) fn mesh_file(raw: Option<&RawTerrain>, dir: &Path) -> Option<String> {
     let t = raw.filter(|t| t.kind == TerrainKind::Mesh)?;
-    let file = Path::new(t.file.as_deref()?);
-    Some(if file.is_absolute() { file.display().to_string() } else { dir.join(file).display().to_string() })
+    Some(dir.join(t.file.as_deref()?).display().to_string())
 }
 
 /// The rows of a CSV file of numbers (blank lines skipped).

@@ -336,11 +336,11 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// 1, 2 and 5 stood at their boundaries (measured). The deadlock also lasts while the body
     /// sways for a blocked leg, until that leg lifts.
     fn lifting(&self, candidates: [bool; 6], support: &[bool; 6], margins: &[f64; 6], estimated: &Htm, boundary: f64) -> [bool; 6] {
-        let swaying = self.sway.map(|(b, _)| b);
-        if self.options.failed_leg.is_none() {
-            return self.stable_lifts(candidates, margins, support, estimated);
-        }
         let lifting = self.stable_lifts(candidates, margins, support, estimated);
+        if self.options.failed_leg.is_none() {
+            return lifting;
+        }
+        let swaying = self.sway.map(|(b, _)| b);
         if !deadlocked(support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
             return lifting;
         }
@@ -429,13 +429,18 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// body frame sits at the centre of the main body, about which the legs are mounted
     /// symmetrically (AMRU5, the PhantomX); the legs' own shift as they swing is left out.
     fn balanced(&self, support: &[bool; 6], estimated: &Htm) -> bool {
-        let feet: Vec<Vector3<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor).collect();
-        let centre = estimated.translation;
         let horizontal = || {
-            let feet: Vec<Vector2<f64>> = feet.iter().map(|f| f.xy()).collect();
-            stability_margin(&centre.xy(), &feet) >= self.options.stability_margin
+            let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
+            stability_margin(&estimated.translation.xy(), &feet) >= self.options.stability_margin
         };
-        energy_stability_margin(&centre, &feet) >= self.options.energy_margin && (self.options.failed_leg.is_none() || horizontal())
+        self.energy_margin_of(support, estimated) >= self.options.energy_margin && (self.options.failed_leg.is_none() || horizontal())
+    }
+
+    /// The normalized energy stability margin ([`super::stability`]) of the anchors of the feet
+    /// `support`, the centre of mass at the estimated body origin (see [`Self::balanced`]).
+    fn energy_margin_of(&self, support: &[bool; 6], estimated: &Htm) -> f64 {
+        let feet: Vec<Vector3<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor).collect();
+        energy_stability_margin(&estimated.translation, &feet)
     }
 }
 
@@ -671,8 +676,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         self.state.deadlock = deadlocked(&support, &margins, &lifting, boundary) || swaying.is_some();
         self.sway = if self.state.deadlock { self.sway(swaying, &support, &lifting, &margins, boundary, &estimated, &desired, h.velocity.xy().norm()) } else { None };
         self.state.deadlocked_periods += usize::from(self.state.deadlock);
-        let standing: Vec<Vector3<f64>> = (0..6).filter(|&l| support[l] && !lifting[l]).map(|l| self.walk.legs[l].anchor).collect();
-        self.state.stability_margin = energy_stability_margin(&estimated.translation, &standing);
+        let standing: [bool; 6] = std::array::from_fn(|l| support[l] && !lifting[l]);
+        self.state.stability_margin = self.energy_margin_of(&standing, &estimated);
         self.state.reaching_down = reaching_down && room > REACH_ROOM;
 
         // The posture as the controller knows it.
