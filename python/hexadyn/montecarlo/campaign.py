@@ -38,7 +38,7 @@ from hexadyn.montecarlo.storage import CampaignStore, RunKey
 from hexadyn.montecarlo.tables import specific_resistance_table, write_results
 from hexadyn.runner import resolve_scenario
 
-__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "Campaign", "run_campaign", "variants_of"]
+__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "Campaign", "run_campaign", "study_tables", "variant_fields", "variants_of"]
 
 #: Scenario of a campaign without an explicit one: the Table 6.2 validation walk.
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
@@ -57,6 +57,26 @@ MAX_SIMULATIONS = 1_000_000
 #: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
 #: (False) or a callable ``progress(finished_runs, total_runs)`` called after each stored run.
 Progress = Union[bool, Callable[[int, int], object]]
+
+
+def variant_fields(variant: str) -> dict[str, Any]:
+    """The scenario fields that select a variant's friction model: dry/viscous (Eq. 6.1),
+    with or without the load influence of Eq. 5.12."""
+    return {"model.friction": "dry_viscous", "model.load_dependence": VARIANTS[variant]}
+
+
+def study_tables(distributions: FrictionDistributions, variant: str = "dry_viscous") -> dict[str, dict[str, Any]]:
+    """The friction of a variant's runs as the ``[fixed]`` and ``[parameters]`` tables of a
+    design study (docs/studies.md): each drawn field a ``truncated_normal`` on its accepted
+    interval (:meth:`FrictionDistributions.accepted_interval`, the distribution
+    :func:`draw_friction` samples by rejection), a field of zero sigma and the robot's fixed
+    fields set as ``[fixed]`` with the variant's friction model. A study of these tables
+    samples what the campaign draws (its design instead of independent draws)."""
+    load = VARIANTS[variant]
+    fields = {f: g for f, g in distributions.gaussians.items() if load or f not in distributions.load_parameters}
+    parameters = {f: {"distribution": "truncated_normal", "range": list(distributions.accepted_interval(f)), "mean": mu, "std": sigma} for f, (mu, sigma) in fields.items() if sigma > 0}
+    fixed = {**variant_fields(variant), **distributions.fixed, **{f: mu for f, (mu, sigma) in fields.items() if sigma == 0}}
+    return {"fixed": fixed, "parameters": parameters}
 
 
 def variants_of(distributions: FrictionDistributions) -> tuple[str, ...]:
@@ -156,8 +176,7 @@ class Campaign:
         return {
             **self.fields,
             "scenario.name": f"{self.scenario_name}-{key.variant}-v{key.velocity_index}-r{key.run_index}",
-            "model.friction": "dry_viscous",
-            "model.load_dependence": VARIANTS[key.variant],
+            **variant_fields(key.variant),
             "gait.heading.vx_m_s": self.velocities_m_per_s[key.velocity_index],
             **self.friction(key),
         }
