@@ -25,14 +25,13 @@ from __future__ import annotations
 import functools
 import math
 import os
-from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence, Union
+from typing import Any, Iterable, Mapping, Sequence
 
 from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
-from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
+from hexadyn.montecarlo.execution import Executor, ProcessPool, Progress, Ray
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction, read_friction_stats
 from hexadyn.montecarlo.storage import CampaignStore, RunKey
 from hexadyn.montecarlo.tables import specific_resistance_table, write_results
@@ -53,10 +52,6 @@ VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
 #: thesis' 8000 (1000 runs, 4 velocities, 2 variants), four and a half days of 60 s walks on
 #: one core at 0.4 s each; its list of runs takes about 100 MB.
 MAX_SIMULATIONS = 1_000_000
-
-#: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
-#: (False) or a callable ``progress(finished_runs, total_runs)`` called after each stored run.
-Progress = Union[bool, Callable[[int, int], object]]
 
 
 def variant_fields(variant: str) -> dict[str, Any]:
@@ -231,26 +226,16 @@ class Campaign:
         return runs.loc[runs["status"] != "ok", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
 
     def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
-        from tqdm.auto import tqdm
+        def stored(key: RunKey, outcome: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+            velocity = self.velocities_m_per_s[key.velocity_index]
+            store.add(key, velocity, self.friction(key), outcome)
+            return [(f"{key.variant}, V_x = {velocity} m/s, run {key.run_index}", outcome)]
 
-        done = total - len(pending)
-        bar = tqdm(total=total, initial=done, desc=self.scenario_name, unit="run", disable=progress is not True)
         tasks: Iterable = ((key, self.overrides(key)) for key in pending)
         # execution.simulate_run as the module holds it when the campaign starts, so that a
         # benchmark's timed replacement is what the workers call.
         simulate = functools.partial(execution.simulate_run, os.fspath(self.scenario))
-        try:
-            with closing(executor.run(simulate, tasks)) as outcomes:
-                for key, outcome in outcomes:
-                    store.add(key, self.velocities_m_per_s[key.velocity_index], self.friction(key), outcome)
-                    done += 1
-                    bar.update()
-                    if outcome["status"] == "failed":
-                        bar.write(f"failed (stored, not retried): {key.variant}, V_x = {self.velocities_m_per_s[key.velocity_index]} m/s, run {key.run_index}: {outcome['error']}")
-                    if callable(progress):
-                        progress(done, total)
-        finally:
-            bar.close()
+        execution.run_and_store(executor, simulate, tasks, stored, name=self.scenario_name, total=total, done=total - len(pending), progress=progress)
 
 
 def run_campaign(

@@ -19,14 +19,19 @@ import signal
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence
+from contextlib import closing
+from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence, Union
 
 from hexadyn.montecarlo.storage import summary_columns
 
-__all__ = ["SERIES_FIGURES", "Executor", "ProcessPool", "Ray", "simulate_run"]
+__all__ = ["SERIES_FIGURES", "Executor", "ProcessPool", "Progress", "Ray", "run_and_store", "simulate_run"]
 
 #: A task: its key (handed back with its result) and the argument of the executor's function.
 Task = tuple[Hashable, Any]
+
+#: ``progress`` argument of a campaign's or a study's ``run``: a tqdm bar over the runs (True),
+#: nothing (False) or a callable ``progress(finished_runs, total_runs)`` called after each store.
+Progress = Union[bool, Callable[[int, int], object]]
 
 #: The figures of a run's summary that :func:`hexadyn.energy.add_energy_figures` computes from
 #: the time series (:func:`hexadyn.simulate` adds them; the engine's summary has the others).
@@ -40,6 +45,30 @@ IN_FLIGHT_PER_CPU = 2
 #: (2.6 % of the 4000-walk campaign's time at 0.13 s per walk, where the process pool loses
 #: 0.3 %); four walks per task pay it once for four.
 WALKS_PER_TASK = 4
+
+
+def run_and_store(executor: Executor, function: Callable[[Any], Any], tasks: Iterable[Task], store: Callable[[Hashable, Any], Sequence[tuple[str, Mapping[str, Any]]]], *, name: str, total: int, done: int, progress: Progress) -> None:
+    """Runs `tasks` on `executor` and hands each finished task's (key, result) to `store`, which
+    stores it and returns (label, outcome) of each run it held; the progress (a tqdm bar named
+    `name` over `total` runs, `done` of them stored before, or the `progress` callable) advances
+    by them, and each failed run is written as one line with its label. Closing on an exception
+    or Ctrl-C stops the workers (:meth:`Executor.run`)."""
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=total, initial=done, desc=name, unit="run", disable=progress is not True)
+    try:
+        with closing(executor.run(function, tasks)) as outcomes:
+            for key, result in outcomes:
+                runs = store(key, result)
+                done += len(runs)
+                bar.update(len(runs))
+                for label, outcome in runs:
+                    if outcome["status"] == "failed":
+                        bar.write(f"failed (stored, not retried): {label}: {outcome['error']}")
+                if callable(progress):
+                    progress(done, total)
+    finally:
+        bar.close()
 
 
 def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[str] | None = None) -> dict[str, Any]:

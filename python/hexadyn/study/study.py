@@ -17,7 +17,6 @@ from __future__ import annotations
 import functools
 import math
 import os
-from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping
@@ -27,8 +26,7 @@ import numpy as np
 from hexadyn import atomic
 from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
-from hexadyn.montecarlo.campaign import Progress
-from hexadyn.montecarlo.execution import SERIES_FIGURES, Executor, ProcessPool, Ray
+from hexadyn.montecarlo.execution import SERIES_FIGURES, Executor, ProcessPool, Progress, Ray
 from hexadyn.montecarlo.storage import Layout, RunStore
 from hexadyn.study import analysis, design
 from hexadyn.study.spec import StudySpec, read_study
@@ -176,27 +174,15 @@ class Study:
         return results
 
     def _simulate(self, store: RunStore, executor: Executor, pending: list[int], progress: Progress) -> None:
-        from tqdm.auto import tqdm
+        def stored(_: Any, results: list[tuple[int, dict[str, Any]]]) -> list[tuple[str, dict[str, Any]]]:
+            store.add_rows([self._row(i, outcome) for i, outcome in results])
+            return [(f"run {i}", outcome) for i, outcome in results]
 
         total = len(self.samples)
-        done = total - len(pending)
         size = self.model.runs_per_task  # type: ignore[attr-defined]
         chunks = (pending[k : k + size] for k in range(0, len(pending), size))
         tasks: Iterable = ((chunk[0], [(i, self.parameters(i)) for i in chunk]) for chunk in chunks)
-        bar = tqdm(total=total, initial=done, desc=self.spec.name, unit="run", disable=progress is not True)
-        try:
-            with closing(executor.run(functools.partial(_evaluate, self.model), tasks)) as outcomes:
-                for _, results in outcomes:
-                    store.add_rows([self._row(i, outcome) for i, outcome in results])
-                    done += len(results)
-                    bar.update(len(results))
-                    for i, outcome in results:
-                        if outcome["status"] == "failed":
-                            bar.write(f"failed (stored, not retried): run {i}: {outcome['error']}")
-                    if callable(progress):
-                        progress(done, total)
-        finally:
-            bar.close()
+        execution.run_and_store(executor, functools.partial(_evaluate, self.model), tasks, stored, name=self.spec.name, total=total, done=total - len(pending), progress=progress)
 
     def _row(self, run_index: int, outcome: Mapping[str, Any]) -> dict[str, Any]:
         outputs = outcome.get("outputs", {})
