@@ -28,7 +28,7 @@ import matplotlib
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-from docs_blocks import LANGUAGES, PAGES, ROOT, Block, blocks, prose
+from docs_blocks import LANGUAGES, PAGES, ROOT, Block, blocks, hexadyn_commands, prose
 
 from hexadyn.cli import cli
 
@@ -81,7 +81,7 @@ AFTER_PAGE = {"docs/add-your-robot.md": the_walk_through_walks}
 def run_block(block: Block, folder: Path, namespace: dict[str, object]) -> None:
     """Runs one block in `folder` (the current directory); `namespace` is the page's script."""
     if block.language == "sh":
-        for command in commands(block):
+        for command in hexadyn_commands(block):
             run_hexadyn(block, command)
     elif block.language == "python":
         exec(compile(block.body, block.where, "exec"), namespace)
@@ -100,18 +100,6 @@ def run_block(block: Block, folder: Path, namespace: dict[str, object]) -> None:
         assert compiled.returncode == 0, f"{block.where}: does not compile:\n{compiled.stderr}"
     elif block.language == "rust":
         pytest.fail(f"{block.where}: a rust block shows a fragment: mark it no-run with the test that compiles the same calls")
-
-
-def commands(block: Block) -> list[list[str]]:
-    """The command lines of an ``sh`` block (comments dropped, ``\\`` continuations joined)."""
-    text = block.body.replace("\\\n", " ")
-    out = []
-    for line in text.splitlines():
-        args = shlex.split(line, comments=True)
-        if args:
-            assert args[0] == "hexadyn", f"{block.where}: {line!r}: a runnable sh block holds hexadyn commands only (mark the block no-run, with the reason)"
-            out.append(args[1:])
-    return out
 
 
 def run_hexadyn(block: Block, args: list[str]) -> None:
