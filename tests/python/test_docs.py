@@ -8,7 +8,8 @@
   described in docs_blocks.py; a block that must not run says why (``no-run: REASON``), and
   each page's count of those is held here, so that one more is a decision, not a slip.
 - The site builds with ``mkdocs build --strict`` (any warning, a broken link first, fails).
-- No placeholder is left, and a measured figure carries its date, machine and commit.
+- No placeholder is left, and a measured figure carries its date, machine (cores and CPU
+  model) and commit.
 """
 
 from __future__ import annotations
@@ -145,6 +146,9 @@ MEASURED = re.compile(
 DATE = re.compile(r"\b20\d\d-\d\d-\d\d\b")
 COMMIT = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
 MACHINE = re.compile(r"\b\d+[- ]cores?\b")
+#: The machine's CPU: its model (`lscpu`'s "Model name"), or, for a figure measured before the
+#: stamps named it, that it was not recorded.
+CPU = re.compile(r"\b(?:AMD EPYC|AMD Ryzen|Intel|Apple M\d|Graviton|Ampere)\b|\bCPU model not recorded\b")
 
 
 def figure_paragraphs(page: str) -> list[tuple[str, str]]:
@@ -167,7 +171,8 @@ def figure_paragraphs(page: str) -> list[tuple[str, str]]:
 def test_measured_figures_carry_their_date_machine_and_commit(page: str) -> None:
     missing = []
     for around, paragraph in figure_paragraphs(page):
-        lacks = [what for what, stamp in (("date", DATE), ("machine (N-core)", MACHINE), ("commit", COMMIT)) if not (stamp.search(paragraph) or stamp.search(around))]
+        stamps = (("date", DATE), ("machine (N-core)", MACHINE), ("CPU model (or 'CPU model not recorded')", CPU), ("commit", COMMIT))
+        lacks = [what for what, stamp in stamps if not (stamp.search(paragraph) or stamp.search(around))]
         if lacks:
             missing.append(f"{', '.join(lacks)}: {paragraph[:100]!r}")
     assert not missing, f"{page}: figures without " + "\n".join(missing)
