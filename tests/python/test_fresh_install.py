@@ -23,6 +23,7 @@ import subprocess
 import sys
 import zipfile
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 from docs_blocks import ROOT, blocks, hexadyn_commands
@@ -41,8 +42,9 @@ OPTIONAL_MODULES = ("hexadyn.view.",)
 
 
 @pytest.fixture(scope="module")
-def fresh(tmp_path_factory) -> Path:
-    """The bin/ folder of a fresh venv holding hexadyn's wheel and its runtime dependencies."""
+def fresh(tmp_path_factory) -> Iterator[Path]:
+    """The bin/ folder of a fresh venv holding hexadyn's wheel and its runtime dependencies
+    (about 1 GB with the wheelhouse: both are removed once used)."""
     folder = tmp_path_factory.mktemp("fresh_install")
     wheel = build_wheel(folder / "dist")
     wheelhouse = folder / "wheelhouse"
@@ -52,7 +54,9 @@ def fresh(tmp_path_factory) -> Path:
     run([sys.executable, "-m", "venv", str(folder / "venv")])
     bin_dir = folder / "venv" / "bin"
     run([str(bin_dir / "python"), "-m", "pip", "install", "--quiet", "--no-index", "--no-compile", "--find-links", str(wheelhouse), "-c", str(LOCK), str(wheel)])
-    return bin_dir
+    shutil.rmtree(wheelhouse)
+    yield bin_dir
+    shutil.rmtree(folder)
 
 
 def run(args: list[str], cwd: Path | None = None, check: bool = True) -> subprocess.CompletedProcess:
