@@ -39,7 +39,8 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 USER_ERRORS: tuple[type[BaseException], ...] = (OSError, ValueError)
 #: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
 INTERRUPTED = 130
-#: Exit status of `simulate --strict` when a health check failed.
+#: Exit status of `--strict` (simulate, compare-friction, montecarlo) when a health check of a
+#: run failed.
 UNHEALTHY = 3
 
 
@@ -198,19 +199,22 @@ def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite:
         click.echo(f"  analysis    skipped {s['analysis_skipped']}")
     if (out / "plots").is_dir():
         click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
-    for warning in s["warnings"]:
+    _warn(s["warnings"], strict)
+
+
+def _warn(warnings: list[str], strict: bool) -> None:
+    """Prints the failed health checks of the runs; with --strict, any ends the command with
+    status :data:`UNHEALTHY`."""
+    for warning in warnings:
         click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
-    if s["warnings"] and strict:
+    if warnings and strict:
         raise SystemExit(UNHEALTHY)
 
 
 def _scenario(scenario: str | None, overrides: dict) -> hexadyn.Scenario:
-    """SCENARIO (default: :data:`DEFAULT_SCENARIO`) with the fields of --set, each checked by
-    the engine as it is set."""
-    run = hexadyn.Scenario.load(scenario or DEFAULT_SCENARIO)
-    for field, value in overrides.items():
-        run.set(field, value)
-    return run
+    """SCENARIO (default: :data:`DEFAULT_SCENARIO`) with the fields of --set, checked by the
+    engine."""
+    return hexadyn.Scenario.load(scenario or DEFAULT_SCENARIO).update(overrides)
 
 
 def _echo_power(results: hexadyn.Results) -> None:
@@ -300,8 +304,9 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @workers_option()
 @no_progress_option()
 @no_plots_option()
+@strict_option(UNHEALTHY)
 @figure_format_option()
-def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, format_: tuple[str, ...]) -> None:
+def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, strict: bool, format_: tuple[str, ...]) -> None:
     """Run the validation walk with each friction model at several velocities (Section 6.4).
 
     SCENARIO (default: the validation case of Table 6.2) is run without friction, with the
@@ -309,7 +314,9 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
     horizontal joints, at each velocity, in parallel. Writes the averaged power per actuator and
     model (Tables 6.3-6.6), the robot power and specific resistance versus velocity with the fit
     P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots. --set changes the scenario's fields
-    for every run (the friction model and the velocity are set over them).
+    for every run (the friction model and the velocity are set over them). Every run checks its
+    own health (as `hexadyn simulate`'s): a failed check is printed and kept in the `warnings`
+    column of robot_power.csv, and makes --strict exit with status 3.
     """
     from hexadyn import compare, energy
 
@@ -336,10 +343,11 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
         click.echo(f"    {line}")
     if result.fit.empty:
         click.echo("  fit P = alpha + beta V_x (Eq. 6.8) skipped: it needs at least two velocities")
-        return
-    click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
-    for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
-        click.echo(f"    {line}")
+    else:
+        click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
+        for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
+            click.echo(f"    {line}")
+    _warn(compare.warning_lines(result), strict)
 
 
 @cli.command()
@@ -367,7 +375,8 @@ def scenarios() -> None:
 @workers_option()
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @no_progress_option()
-def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress) -> None:
+@strict_option(UNHEALTHY)
+def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress, strict) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
     Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm, or with --robot
@@ -377,10 +386,12 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     every run (the drawn friction and the velocity are set over them). Rerunning the same command resumes an
     interrupted campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf
     to --out. A campaign with failed simulations (stored, not retried) ends with one line
-    naming them and exit status 1.
+    naming them and exit status 1. Every run checks its own health (as `hexadyn simulate`'s,
+    kept in runs.sqlite): the runs that failed a check are named in one WARNING line, and
+    --strict then exits with status 3.
     """
     from hexadyn.montecarlo import DEFAULT_SCENARIOS, Campaign
-    from hexadyn.montecarlo.tables import failure_line
+    from hexadyn.montecarlo.tables import failure_line, warning_line
 
     if scenario is not None and robot is not None:
         raise click.BadParameter(f"--robot {robot} with the scenario {scenario}: the scenario names its robot; give one of them", param_hint="--robot")
@@ -411,8 +422,12 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     click.echo(f"Specific resistance xi = E/(m g l) (Table 6.8), {campaign.scenario_name}, seed {seed}:")
     click.echo(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
+    unhealthy = campaign.unhealthy(out)
+    warnings = [] if unhealthy.empty else [warning_line(unhealthy, len(campaign.keys()), out)]
     if table["failed"].any():
+        _warn(warnings, strict=False)
         raise click.ClickException(failure_line(campaign.failures(out), len(campaign.keys()), out))
+    _warn(warnings, strict)
 
 
 @cli.command("export")

@@ -15,8 +15,9 @@ Outputs (:func:`compare_friction`, written atomically by :func:`save`):
   rows legs 0-5 and total, one column per model);
 - ``robot_power.csv``: per velocity and model the averaged robot power, the electrical and
   friction energies, the distance walked, the specific resistance ξ (Eq. 6.6), the friction
-  share (friction work over electrical energy) and the share of the power due to friction
-  (1 - P_none / P_model, Section 6.6: "more than 80 %");
+  share (friction work over electrical energy), the failed health checks of the run
+  (``warnings``, :func:`hexadyn.health.check`, separated by ``; ``, empty for a healthy run) and
+  the share of the power due to friction (1 - P_none / P_model, Section 6.6: "more than 80 %");
 - ``fit.csv``: per model α and β of P = α + β V_x (Eq. 6.8) and the asymptote β / (m g) of ξ;
 - ``plots/``: Fig. 6.19 (a) power and (b) specific resistance versus velocity with the fits,
   and the averaged power per actuator and model (Tables 6.3-6.6 as bar charts).
@@ -63,6 +64,8 @@ DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
 VELOCITY_FIELD = "gait.heading.vx_m_s"
 #: Columns of the fit table (no rows with a single velocity: the fit needs two).
 FIT_COLUMNS = ("alpha_w", "beta_n", "xi_asymptote", "mass_kg")
+#: Separates the failed health checks of a run in the ``warnings`` column.
+WARNING_SEPARATOR = "; "
 POWER_FILE = "power_by_model.csv"
 ROBOT_FILE = "robot_power.csv"
 FIT_FILE = "fit.csv"
@@ -75,6 +78,7 @@ __all__ = [
     "figures",
     "joint_tables",
     "save",
+    "warning_lines",
 ]
 
 
@@ -85,7 +89,8 @@ class Comparison:
     scenario: str
     #: Averaged power per (velocity_m_s, model, leg) and joint type q_r, q_v, q_h, total (W).
     power: pd.DataFrame
-    #: One row per (velocity_m_s, model): robot power, energies, distance, ξ, friction shares.
+    #: One row per (velocity_m_s, model): robot power, energies, distance, ξ, friction shares,
+    #: the run's failed health checks (``warnings``).
     robot: pd.DataFrame
     #: One row per model: alpha_w, beta_n, xi_asymptote (β / (m g)), mass_kg.
     fit: pd.DataFrame
@@ -132,6 +137,7 @@ def _run(scenario: str, base: Mapping[str, Any], model: str, velocity: float) ->
             "mass_kg": s["robot_mass_kg"],
             "specific_resistance": s.get("specific_resistance", np.nan),
             "friction_share": s["friction_share"],
+            "warnings": WARNING_SEPARATOR.join(s["warnings"]),
         },
     }
 
@@ -239,6 +245,13 @@ def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: l
     fit = pd.DataFrame.from_dict(fit_rows, orient="index", columns=list(FIT_COLUMNS)).rename_axis("model")
     table_velocity = own_velocity if own_velocity in velocities else velocities[0]
     return Comparison(name, power, robot, fit, table_velocity)
+
+
+def warning_lines(comparison: Comparison) -> list[str]:
+    """The runs that failed a health check, one line each naming the model and the velocity
+    (empty: every run healthy)."""
+    robot = comparison.robot
+    return [f"friction model {model}, V_x = {velocity:g} m/s: {warnings}" for (velocity, model), warnings in robot["warnings"].items() if warnings]
 
 
 def joint_tables(comparison: Comparison, velocity: float | None = None) -> dict[str, pd.DataFrame]:

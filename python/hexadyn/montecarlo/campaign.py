@@ -23,6 +23,7 @@ influence, so only the ``dry_viscous`` variant.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -33,7 +34,7 @@ from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
 from hexadyn.montecarlo.execution import Executor, ProcessPool, Progress, Ray
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction, read_friction_stats
-from hexadyn.montecarlo.storage import CampaignStore, RunKey
+from hexadyn.montecarlo.storage import WARNINGS_COLUMN, CampaignStore, RunKey
 from hexadyn.montecarlo.tables import specific_resistance_table, write_results
 from hexadyn.runner import resolve_scenario
 
@@ -205,7 +206,8 @@ class Campaign:
         more workers than runs left to simulate. On Ctrl-C (KeyboardInterrupt, also raised by
         ``progress``) the running simulations are stopped and the finished ones are kept:
         running again resumes. Failed simulations are stored and counted in the table's
-        ``failed`` column (:meth:`failures` lists them).
+        ``failed`` column (:meth:`failures` lists them); so are the failed health checks of
+        each run (:meth:`unhealthy` lists the runs with any).
         """
         executor: Executor = Ray(ray, workers) if ray else ProcessPool(workers)
         keys = self.keys()
@@ -221,9 +223,23 @@ class Campaign:
     def failures(self, out: str | os.PathLike):
         """The failed simulations stored in the campaign folder ``out``: a DataFrame of
         ``variant``, ``velocity_m_s``, ``run_index`` and ``error``, in run order."""
-        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
-            runs = store.runs()
+        runs = self._runs(out)
         return runs.loc[runs["status"] != "ok", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
+
+    def unhealthy(self, out: str | os.PathLike):
+        """The simulations stored in the campaign folder ``out`` that failed a health check
+        (:func:`hexadyn.health.check`): a DataFrame of ``variant``, ``velocity_m_s``,
+        ``run_index`` and ``warnings`` (the list of the failed checks), in run order. Runs
+        stored by a hexadyn that did not record the checks (``warnings`` NULL) are not listed."""
+        runs = self._runs(out)
+        runs = runs.loc[runs["status"] == "ok", ["variant", "velocity_m_s", "run_index", WARNINGS_COLUMN]]
+        runs[WARNINGS_COLUMN] = [json.loads(w) if isinstance(w, str) else [] for w in runs[WARNINGS_COLUMN]]  # NULL (NaN): not checked
+        return runs[runs[WARNINGS_COLUMN].map(bool)].reset_index(drop=True)
+
+    def _runs(self, out: str | os.PathLike):
+        """Every run stored in the campaign folder ``out`` (:meth:`CampaignStore.runs`)."""
+        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
+            return store.runs()
 
     def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
         def stored(key: RunKey, outcome: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
