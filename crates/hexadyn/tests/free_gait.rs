@@ -235,7 +235,7 @@ fn free_gait_walks_on_five_legs_leg_2_failed() {
 
 // NOT MET on the full dynamic model with a leg failed at an end of the walk (issue 37; all
 // six walk forwards on the ideal plant, `control::gait::free::tests`). Measured with the
-// footholds of `control::gait::free::five_legs` (2026-11-28, 2-core container): with the leg
+// footholds of `control::gait::free::five_legs` (2026-11-28, 2-core container, 1b96aa7): with the leg
 // failed at the trailing end (4 or 5 forwards, 0 or 1 backwards) the walk no longer halts for
 // good (it did after 0.28 m): 0.961-0.962 m net advance, longest deadlock 4.6 s, 76 landings all
 // detected, but the body rocks onto two feet for 0.77-1.19 s at a time (the two middle legs, or
