@@ -83,7 +83,7 @@ def test_bad_input_is_refused_before_running(short_walk: Path, tmp_path: Path, m
         (["--velocities", "1,10"], "V_x = 0.1 m/s"),
         (["--velocities", "-1"], "allowed: positive velocities"),
         (["--velocities", "1,x"], "comma-separated velocities in cm/s"),
-        (["--models", "lugre,coulomb"], "allowed: none, dry_viscous, lugre, dry_viscous_load"),
+        (["--models", "lugre,coulomb"], "allowed: none, dry_viscous, lugre, dry_viscous_load, efficiency"),
     ]:
         result = runner.invoke(cli, ["compare-friction", str(short_walk), "--no-progress", *args], prog_name="hexadyn")
         assert result.exit_code != 0 and message in result.output and "Traceback" not in result.output, (args, result.output)
