@@ -297,7 +297,7 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @cli.command("compare-friction")
 @click.argument("scenario", required=False, default=None)
 @click.option("--velocities", default="1,1.5,2,2.5", show_default=True, callback=_parse_velocities, help="Forward velocities V_x in cm/s (Table 6.2, Fig. 6.19), comma-separated.")
-@click.option("--models", default=None, help="Friction models, comma-separated (default: all four: none, dry_viscous, lugre, dry_viscous_load).")
+@click.option("--models", default=None, help="Friction models, comma-separated (default: all five: none, dry_viscous, lugre, dry_viscous_load, efficiency).")
 @set_option()
 @out_option("Output folder (default: results/compare_friction_<scenario name>, numbered if it exists).")
 @overwrite_option()
@@ -310,8 +310,8 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
     """Run the validation walk with each friction model at several velocities (Section 6.4).
 
     SCENARIO (default: the validation case of Table 6.2) is run without friction, with the
-    dry/viscous model, with LuGre, and with the dry/viscous model plus the load dependence of the
-    horizontal joints, at each velocity, in parallel. Writes the averaged power per actuator and
+    dry/viscous model, with LuGre, with the dry/viscous model plus the load dependence of the
+    horizontal joints, and with the transmission-efficiency law, at each velocity, in parallel. Writes the averaged power per actuator and
     model (Tables 6.3-6.6), the robot power and specific resistance versus velocity with the fit
     P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots. --set changes the scenario's fields
     for every run (the friction model and the velocity are set over them). Every run checks its

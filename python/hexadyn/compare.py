@@ -3,7 +3,8 @@ Fig. 6.19).
 
 One scenario (by default the validation case of Table 6.2) is run with each friction model of
 :data:`MODELS` (no friction, dry/viscous Eq. 6.1, LuGre, dry/viscous with the load dependence of
-the horizontal joints Eq. 5.12) at each velocity V_x, in parallel on the local cores. The
+the horizontal joints Eq. 5.12, and the transmission-efficiency law of the thesis' prospects,
+Chapter 8) at each velocity V_x, in parallel on the local cores. The
 scenario fields are changed through the overrides of :func:`hexadyn.simulate`; the step period
 and the number of steps stay those of the scenario, so the step length grows with V_x as in
 Section 6.3.
@@ -47,6 +48,7 @@ MODELS: dict[str, dict[str, Any]] = {
     "dry_viscous": {"model.friction": "dry_viscous", "model.load_dependence": False},
     "lugre": {"model.friction": "lugre", "model.load_dependence": False},
     "dry_viscous_load": {"model.friction": "dry_viscous", "model.load_dependence": True},
+    "efficiency": {"model.friction": "efficiency", "model.load_dependence": False},
 }
 #: Legend labels of the models.
 MODEL_LABELS = {
@@ -54,10 +56,11 @@ MODEL_LABELS = {
     "dry_viscous": "dry/viscous",
     "lugre": "LuGre",
     "dry_viscous_load": "dry/viscous + load",
+    "efficiency": "efficiency",
 }
 #: Colour and marker of each model in every figure.
-MODEL_COLOURS = {"none": "#1f4e79", "dry_viscous": "#c0392b", "lugre": "#2e8b57", "dry_viscous_load": "#e67e22"}
-MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_load": "D"}
+MODEL_COLOURS = {"none": "#1f4e79", "dry_viscous": "#c0392b", "lugre": "#2e8b57", "dry_viscous_load": "#e67e22", "efficiency": "#7d3c98"}
+MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_load": "D", "efficiency": "v"}
 #: Velocities V_x of Table 6.2 and Fig. 6.19 (m/s).
 DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
 #: Scenario field of the forward velocity.

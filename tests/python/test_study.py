@@ -297,6 +297,25 @@ def test_friction_study_reproduces_the_monte_carlo_campaign(tmp_path):
     assert abs(std_mc - std_study) <= se_std, (std_mc, std_study, se_std)
 
 
+def test_shipped_efficiency_study_sets_the_efficiency_law_beside_the_load_dependence(tmp_path: Path):
+    """docs/studies.md, efficiency against load-dependent friction, on one step (12 s) of its
+    walk: the grid holds the robot's efficiency, the specific resistance falls as the horizontal
+    screws' forward efficiency rises, and at the robot's efficiency it stays below the
+    load-dependent friction's (Section 6.4.4) and above the dry/viscous one's."""
+    spec = read_study(STUDIES / "efficiency_vs_load_dependent.toml")
+    key = "model.joint_friction.q_h.eta_forward"
+    assert spec.design.method == "grid" and [p.key for p in spec.parameters] == [key] and 0.638 in spec.parameters[0].values
+    step = {"scenario.duration_s": 12.0}
+    runs = Study.create(spec, fixed=step).run(tmp_path / "study", workers=1, progress=False, plots=False).runs
+    assert (runs["status"] == "ok").all()
+    xi = runs.set_index(key)["specific_resistance"]
+    assert (np.diff(xi.to_numpy()) < 0).all(), xi
+    walk = "validation_tripod_1_5cm"
+    load = hexadyn.simulate(walk, progress=False, overrides={**step, "model.friction": "dry_viscous", "model.load_dependence": True}).summary["specific_resistance"]
+    dry = hexadyn.simulate(walk, progress=False, overrides={**step, "model.friction": "dry_viscous"}).summary["specific_resistance"]
+    assert dry < xi[0.638] < load, (dry, xi[0.638], load)
+
+
 # ----------------------------------------------------------------------------------------------
 # Validation: one line naming the file, the field, the value and what is allowed
 # ----------------------------------------------------------------------------------------------

@@ -292,6 +292,9 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     if m.load_dependence && m.friction == FrictionModel::None {
         return Err(e(c.err("model.load_dependence", "true", "needs joint friction", "false with friction = \"none\" (or friction = \"dry_viscous\" or \"lugre\")")));
     }
+    if m.load_dependence && m.friction == FrictionModel::Efficiency {
+        return Err(e(c.err("model.load_dependence", "true", "the efficiency law's loss already follows the transmitted load", "false with friction = \"efficiency\" (Eq. 5.12 goes with friction = \"dry_viscous\" or \"lugre\")")));
+    }
     model.load_dependence = m.load_dependence;
     model.inductance = m.inductance;
     let ground = model.ground;
