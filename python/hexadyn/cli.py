@@ -191,7 +191,7 @@ def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite:
             f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
-    if report.in_memory(results):
+    if report.skipped_analysis(results) is None:
         _echo_power(results)
         _echo_ground_detection(results)
     else:

@@ -299,7 +299,8 @@ def energy_figures(results: Results) -> dict[str, float]:
     duration = float(t[-1] - t[0])
     mass = robot_mass(results)
     figures = {
-        "average_power_w": e_el / duration,
+        # A run stopped at its first instant (a safety stop of `hexadyn robot run`) has no duration.
+        "average_power_w": e_el / duration if duration > 0 else math.nan,
         "energy_mechanical_j": float(b["mechanical_j"].sum()),
         "friction_share": float(b["friction_j"].sum()) / e_el if e_el else math.nan,
         "joule_share": float(b["joule_j"].sum()) / e_el if e_el else math.nan,
