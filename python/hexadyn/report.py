@@ -157,6 +157,7 @@ def write_csv(path: Path, table: pd.DataFrame) -> None:
 
 
 def _figures(results: Results, legs: Sequence[int] | None) -> dict[str, Figure]:
+    energy.control_period(results)  # a time axis the figures can be drawn on, or ValueError
     return plotting.figures(results, plotting.DEFAULT_LEGS if legs is None else legs)
 
 
