@@ -192,7 +192,7 @@ def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite:
             f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
-    if report.in_memory(results):
+    if report.skipped_analysis(results) is None:
         _echo_power(results)
         _echo_ground_detection(results)
     else:
@@ -279,7 +279,10 @@ def plot(folder: Path, legs: tuple[int, ...], format_: tuple[str, ...], no_progr
     results = hexadyn.Results.load(folder)
     if not report.in_memory(results):
         raise ValueError(f"{folder}: the time series ({results.shape[0]} instants) is too long to plot in memory; plot a part of it from Python (Results.read_columns)")
-    figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
+    try:
+        figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
+    except ValueError as exc:  # what the figures cannot be drawn from, said of the folder
+        raise ValueError(f"{folder}: {exc}") from exc
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(format_)} formats)")
 
 

@@ -393,7 +393,9 @@ def read_metadata(folder: str | os.PathLike) -> dict[str, Any]:
 def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
     """The Parquet file of a time series, opened as an input file
     (:func:`hexadyn.inputs.open_input`) and closed on leaving; ValueError naming it if it is
-    missing or not a Parquet file."""
+    missing, not a Parquet file, or holds a column twice (a column would then be a table)."""
+    import collections
+
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -402,6 +404,9 @@ def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
             file = pq.ParquetFile(source)
         except (pa.ArrowException, OSError) as exc:
             raise ValueError(f"{path}: not a readable time series: {exc}") from None
+        repeated = [(name, n) for name, n in collections.Counter(file.schema_arrow.names).items() if n > 1]
+        if repeated:
+            raise ValueError(f"{path}: column `{repeated[0][0]}` appears {repeated[0][1]} times; allowed: a time series of distinct columns")
         yield file
 
 

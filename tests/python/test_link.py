@@ -233,3 +233,19 @@ def test_an_interrupt_is_a_stop_with_its_reason(tmp_path):
 def test_faults_are_rehearsed_on_the_emulated_slaves_only():
     result = CliRunner().invoke(cli, ["robot", "run", "stand_six_legs", "--link", "loopback", "--no-progress", "--silent-slave", "3:40"])
     assert result.exit_code == 1 and result.output.strip() == "Error: --silent-slave: faults are rehearsed on the emulated slaves only; allowed with --emulated", result.output
+
+
+def test_a_safety_stop_at_the_first_instant_saves_its_results_and_reason(tmp_path):
+    """Found by test_fuzz_cli.py: a rehearsal whose slaves lose half their packets stops at
+    period 3 with a single recorded instant; its average power was 0/0 (ZeroDivisionError) and
+    its power table had no period to average over. The folder is saved with the stop's reason,
+    the analyses that need a period are skipped with a note, and the command ends in one line."""
+    scenario = shortened("stand_six_legs", tmp_path, 0.03)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(cli, ["robot", "run", str(scenario), "--link", "loopback", "--emulated", "--loss", "0.5", "--no-progress", "--out", str(out)])
+    assert result.exit_code == 1 and result.exception is not None and isinstance(result.exception, SystemExit), result.output
+    assert result.stderr.splitlines() == ["Error: safety stop at period 3: no packet from the slave(s) of leg(s) [1] for 3 periods, the master on time; every motor set to 0 V"]
+    saved = Results.load(out)
+    assert saved.shape[0] == 1 and saved.summary["safety_stop_reason"] == "missing_replies"
+    assert saved.summary["analysis_skipped"] == "power.csv and the figures: the time series has a single instant: no control period to average powers over"
+    assert not (out / "power.csv").exists() and not (out / "plots").exists()

@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -458,3 +459,49 @@ def test_every_shipped_scenario_passes_strict(name: str, tmp_path: Path):
     result = invoke("simulate", name, *cut, "--strict", "--no-plots", "--no-progress", "--out", str(tmp_path / "run"))
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["warnings"] == []
+
+
+@pytest.mark.parametrize("command", ["plot", "identify", "export"])
+def test_a_time_series_holding_a_column_twice_is_named_in_one_line(saved: Path, tmp_path: Path, command: str):
+    """Found by test_fuzz_cli.py: a time series with a column renamed to the name of another
+    made that column a table, and `hexadyn identify` ended in an AttributeError traceback."""
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    table = pq.read_table(saved / "timeseries.parquet")
+    pq.write_table(table.rename_columns([table.column_names[0] if i == 1 else c for i, c in enumerate(table.column_names)]), broken / "timeseries.parquet")
+    args = {"plot": ["plot", str(broken)], "identify": ["identify", str(broken), "--out", str(tmp_path / "ident")], "export": ["export", str(broken), "--format", "csv"]}[command]
+    result = invoke(*args)
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {'' if command != 'identify' else f'{broken}: cannot read the results folder: '}{broken / 'timeseries.parquet'}: column `{table.column_names[0]}` appears 2 times; allowed: a time series of distinct columns"], result.stderr
+
+
+@pytest.mark.parametrize("edit, words", [("single", "the time series has a single instant"), ("constant", "the time series' instants do not increase (median step 0 s)")])
+def test_plot_refuses_a_time_axis_it_cannot_draw_on_in_one_line(saved: Path, tmp_path: Path, edit: str, words: str):
+    """Found by test_fuzz_cli.py: `hexadyn plot` of a time series cut to one instant, or whose
+    times were all made equal, drew its figures with matplotlib's warning of a singular axis on
+    stderr. The figures are refused first, in one line naming the folder."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    table = pq.read_table(saved / "timeseries.parquet")
+    if edit == "single":
+        table = table.slice(0, 1)
+    else:
+        t = table.column_names.index("t")
+        table = table.set_column(t, "t", pa.array([1.0] * table.num_rows))
+    pq.write_table(table, broken / "timeseries.parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and result.stderr.startswith(f"Error: {broken}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
+    assert not (broken / "plots").exists()

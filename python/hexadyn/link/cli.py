@@ -129,7 +129,7 @@ def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: 
     results = Results.from_engine(raw, scenario_path=path)
     energy.add_energy_figures(results)
     report.save(results, out, overwrite=overwrite)
-    if not no_plots:
+    if not no_plots and report.skipped_analysis(results) is None:
         _save_plots(results, out / report.PLOTS_DIR, progress=not no_progress)
     s = results.summary
     click.echo(f"Results: {out}")
