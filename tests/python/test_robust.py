@@ -461,17 +461,22 @@ def test_every_shipped_scenario_passes_strict(name: str, tmp_path: Path):
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["warnings"] == []
 
 
+def copy_of_results(saved: Path, broken: Path) -> Path:
+    """A copy of the files of the results folder `saved` in the new folder `broken`, to break."""
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    return broken
+
+
 @pytest.mark.parametrize("command", ["plot", "identify", "export"])
 def test_a_time_series_holding_a_column_twice_is_named_in_one_line(saved: Path, tmp_path: Path, command: str):
     """Found by test_fuzz_cli.py: a time series with a column renamed to the name of another
     made that column a table, and `hexadyn identify` ended in an AttributeError traceback."""
     import pyarrow.parquet as pq
 
-    broken = tmp_path / "broken"
-    broken.mkdir()
-    for p in saved.iterdir():
-        if p.is_file():
-            (broken / p.name).write_bytes(p.read_bytes())
+    broken = copy_of_results(saved, tmp_path / "broken")
     table = pq.read_table(saved / "timeseries.parquet")
     pq.write_table(table.rename_columns([table.column_names[0] if i == 1 else c for i, c in enumerate(table.column_names)]), broken / "timeseries.parquet")
     args = {"plot": ["plot", str(broken)], "identify": ["identify", str(broken), "--out", str(tmp_path / "ident")], "export": ["export", str(broken), "--format", "csv"]}[command]
@@ -488,11 +493,7 @@ def test_plot_refuses_a_time_axis_it_cannot_draw_on_in_one_line(saved: Path, tmp
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    broken = tmp_path / "broken"
-    broken.mkdir()
-    for p in saved.iterdir():
-        if p.is_file():
-            (broken / p.name).write_bytes(p.read_bytes())
+    broken = copy_of_results(saved, tmp_path / "broken")
     table = pq.read_table(saved / "timeseries.parquet")
     if edit == "single":
         table = table.slice(0, 1)
