@@ -283,6 +283,8 @@ def plot(folder: Path, legs: tuple[int, ...], format_: tuple[str, ...], no_progr
         figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
     except ValueError as exc:  # what the figures cannot be drawn from, said of the folder
         raise ValueError(f"{folder}: {exc}") from exc
+    except KeyError as exc:  # a column the figures need, missing from a damaged time series
+        raise ValueError(f"{folder}: the time series has no column {exc}; allowed: the columns the run that wrote the folder recorded") from exc
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(format_)} formats)")
 
 

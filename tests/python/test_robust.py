@@ -5,6 +5,7 @@ ranges and unhealthy runs are reported, and broken inputs give one line naming t
 from __future__ import annotations
 
 import json
+import math
 import os
 import random
 import re
@@ -506,3 +507,25 @@ def test_plot_refuses_a_time_axis_it_cannot_draw_on_in_one_line(saved: Path, tmp
         result = invoke("plot", str(broken))
     assert result.exit_code == 1 and result.stderr.startswith(f"Error: {broken}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
     assert not (broken / "plots").exists()
+
+
+@pytest.mark.parametrize("edit, words", [("drop", "the time series has no column 'q_r[0]'"), ("phase", "column `phase[3]` = nan at t = 0 s: not a foot phase; allowed: the codes")])
+def test_plot_names_a_missing_column_or_a_phase_that_is_no_phase(tmp_path: Path, edit: str, words: str):
+    """Found by test_fuzz_cli.py: `hexadyn plot` of a time series without a joint's column ended
+    in a KeyError traceback; with a foot phase made NaN it drew figures with numpy's cast
+    warnings on stderr. Both are refused in one line naming the folder and the column."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder = tmp_path / "walk"
+    hexadyn.simulate(shortened("validation_tripod_1_5cm", tmp_path, 0.05), folder, progress=False)
+    table = pq.read_table(folder / "timeseries.parquet")
+    if edit == "drop":
+        table = table.drop_columns(["q_r[0]"])
+    else:
+        table = table.set_column(table.column_names.index("phase[3]"), "phase[3]", pa.array([math.nan] * table.num_rows))
+    pq.write_table(table, folder / "timeseries.parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = invoke("plot", str(folder))
+    assert result.exit_code == 1 and result.stderr.startswith(f"Error: {folder}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
