@@ -257,13 +257,19 @@ class Results:
     @classmethod
     def load(cls, folder: str | os.PathLike) -> "Results":
         """Reads a results folder (written by :func:`hexadyn.report.save`); the time series is
-        read on first access. Raises ValueError naming the file for a broken folder."""
+        read on first access. Raises ValueError naming the file for a broken folder, or for a
+        time series without a column its metadata lists (the analyses go by the metadata)."""
         folder = Path(folder)
         metadata = read_metadata(folder)
         summary = _read_json_object(folder / SUMMARY_FILE, "the run's summary")
-        inputs.check_input(_existing(folder / TIMESERIES_FILE, "the Parquet file of the time series"), limit=None)
+        units = metadata.get("units", {})
+        with open_series(folder / TIMESERIES_FILE) as file:
+            held = set(file.schema_arrow.names)
+        missing = [c for c in units if c not in held]
+        if missing:
+            raise ValueError(f"{folder / TIMESERIES_FILE}: no column `{missing[0]}`{f' (and {len(missing) - 1} more)' if len(missing) > 1 else ''}, which {METADATA_FILE} lists; allowed: a time series of the columns of its metadata")
         metadata.pop("columns", None)
-        return cls(None, metadata.get("units", {}), summary, metadata, path=folder)
+        return cls(None, units, summary, metadata, path=folder)
 
 
 class SeriesWriter:
