@@ -548,3 +548,14 @@ def test_a_time_series_without_a_column_its_metadata_lists_is_refused_when_loade
     result = invoke(command[0], str(broken), *command[1:])
     assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
     assert result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: no column `u_q_r[4]` (and 1 more), which metadata.json lists; allowed: a time series of the columns of its metadata"]
+
+
+def test_an_infinite_duration_is_refused_naming_the_field(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = inf` passed the check of at least one control
+    period, and `hexadyn simulate` ended in an OverflowError traceback (the rows of an infinite
+    run)."""
+    path = tmp_path / "forever.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="inf"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress")
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {path}:10: field `scenario.duration_s` = inf: not a finite number; allowed: a finite duration >= 0.01 s (one control period)"], result.stderr
