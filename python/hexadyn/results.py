@@ -399,7 +399,8 @@ def read_metadata(folder: str | os.PathLike) -> dict[str, Any]:
 def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
     """The Parquet file of a time series, opened as an input file
     (:func:`hexadyn.inputs.open_input`) and closed on leaving; ValueError naming it if it is
-    missing, not a Parquet file, or holds a column twice (a column would then be a table)."""
+    missing, not a Parquet file, holds a column twice (a column would then be a table) or a
+    column of other values than numbers."""
     import collections
 
     import pyarrow as pa
@@ -413,6 +414,9 @@ def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
         repeated = [(name, n) for name, n in collections.Counter(file.schema_arrow.names).items() if n > 1]
         if repeated:
             raise ValueError(f"{path}: column `{repeated[0][0]}` appears {repeated[0][1]} times; allowed: a time series of distinct columns")
+        other = next((f for f in file.schema_arrow if not (pa.types.is_floating(f.type) or pa.types.is_integer(f.type))), None)
+        if other is not None:
+            raise ValueError(f"{path}: column `{other.name}` holds {other.type} values; allowed: a time series of numbers")
         yield file
 
 

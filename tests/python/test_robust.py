@@ -559,3 +559,31 @@ def test_an_infinite_duration_is_refused_naming_the_field(tmp_path: Path):
     result = invoke("simulate", str(path), "--no-plots", "--no-progress")
     assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
     assert result.stderr.splitlines() == [f"Error: {path}:10: field `scenario.duration_s` = inf: not a finite number; allowed: a finite duration >= 0.01 s (one control period)"], result.stderr
+
+
+def test_a_duration_too_long_for_an_integer_count_is_refused_as_too_large(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = 1e308` made the count of instants infinite:
+    an OverflowError traceback before the check of the memory a series takes."""
+    path = tmp_path / "long.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="1e308"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert len(result.stderr.splitlines()) == 1 and "Error: the time series would take about inf TB (inf instants x" in result.stderr, result.stderr
+
+
+def test_a_time_series_column_of_text_is_named_in_one_line(saved: Path, tmp_path: Path):
+    """Found by test_fuzz_cli.py: a time series column of strings reached the figures' sums:
+    a numpy casting traceback from `hexadyn plot`."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    table = pq.read_table(saved / "timeseries.parquet")
+    table = table.set_column(table.column_names.index("q_v[2]"), "q_v[2]", pa.array(["x"] * table.num_rows))
+    pq.write_table(table, broken / "timeseries.parquet")
+    result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: column `q_v[2]` holds string values; allowed: a time series of numbers"], (result.output, result.exception)
