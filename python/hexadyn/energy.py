@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from hexadyn import _core
-from hexadyn.vocabulary import LANDING, LEGS, PHASE_CODES, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
+from hexadyn.vocabulary import LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column, phase_codes
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -138,12 +138,7 @@ def foot_phases(results: Results) -> pd.DataFrame | None:
     columns = [leg_column("phase", leg) for leg in LEGS]
     if not all(c in ts.columns for c in columns):
         return None
-    values = ts[columns].to_numpy()[:-1]
-    known = np.isin(values, list(PHASE_CODES.values()))
-    if not known.all():
-        row, column = np.argwhere(~known)[0]
-        raise ValueError(f"column `{columns[column]}` = {float(values[row, column]):g} at t = {ts.index[row]:g} s: not a foot phase; allowed: the codes {sorted(PHASE_CODES.values())} ({', '.join(PHASE_CODES)})")
-    codes = values.astype(int)
+    codes = phase_codes(ts[columns].to_numpy()[:-1], columns, ts.index).astype(int)
     return pd.DataFrame(codes, index=ts.index[1:], columns=list(LEGS))
 
 

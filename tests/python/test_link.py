@@ -249,3 +249,13 @@ def test_a_safety_stop_at_the_first_instant_saves_its_results_and_reason(tmp_pat
     assert saved.shape[0] == 1 and saved.summary["safety_stop_reason"] == "missing_replies"
     assert saved.summary["analysis_skipped"] == "power.csv and the figures: the time series has a single instant: no control period to average powers over"
     assert not (out / "power.csv").exists() and not (out / "plots").exists()
+
+
+@pytest.mark.parametrize("command", ["emulate", "run"])
+def test_a_negative_fault_seed_is_a_usage_error(command):
+    """Found by test_fuzz_cli.py: `--seed -1` reached the engine's unsigned seed: an
+    OverflowError traceback."""
+    result = CliRunner().invoke(cli, ["robot", command, "stand_six_legs", "--link", "loopback", "--seed", "-1"])
+    assert result.exit_code == 2 and result.exception is not None and isinstance(result.exception, SystemExit)
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: Invalid value for '--seed': -1 is not in the range 0<=x<=18446744073709551615"), lines

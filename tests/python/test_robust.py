@@ -513,7 +513,8 @@ def test_plot_refuses_a_time_axis_it_cannot_draw_on_in_one_line(saved: Path, tmp
 def test_plot_names_a_missing_column_or_a_phase_that_is_no_phase(tmp_path: Path, edit: str, words: str):
     """Found by test_fuzz_cli.py: `hexadyn plot` of a time series without a joint's column ended
     in a KeyError traceback; with a foot phase made NaN it drew figures with numpy's cast
-    warnings on stderr. Both are refused in one line naming the folder and the column."""
+    warnings on stderr. Both are refused in one line naming the folder and the column (the
+    column dropped from the metadata too: else the folder is refused when loaded, below)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -522,6 +523,9 @@ def test_plot_names_a_missing_column_or_a_phase_that_is_no_phase(tmp_path: Path,
     table = pq.read_table(folder / "timeseries.parquet")
     if edit == "drop":
         table = table.drop_columns(["q_r[0]"])
+        metadata = json.loads((folder / "metadata.json").read_text())
+        del metadata["units"]["q_r[0]"]
+        (folder / "metadata.json").write_text(json.dumps(metadata))
     else:
         table = table.set_column(table.column_names.index("phase[3]"), "phase[3]", pa.array([math.nan] * table.num_rows))
     pq.write_table(table, folder / "timeseries.parquet")
@@ -529,3 +533,60 @@ def test_plot_names_a_missing_column_or_a_phase_that_is_no_phase(tmp_path: Path,
         warnings.simplefilter("error")
         result = invoke("plot", str(folder))
     assert result.exit_code == 1 and result.stderr.startswith(f"Error: {folder}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
+
+
+@pytest.mark.parametrize("command", [["export", "--format", "mcap"], ["export", "--format", "csv"], ["plot"], ["ground-detection"]])
+def test_a_time_series_without_a_column_its_metadata_lists_is_refused_when_loaded(saved: Path, tmp_path: Path, command: list[str]):
+    """Found by test_fuzz_cli.py: `hexadyn export --format mcap` of a time series that lost a
+    motor current its metadata lists ended in a KeyError traceback. The folder is refused when
+    loaded, naming the file and the column."""
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    pq.write_table(pq.read_table(saved / "timeseries.parquet").drop_columns(["i_q_r[4]", "u_q_r[4]"]), broken / "timeseries.parquet")
+    result = invoke(command[0], str(broken), *command[1:])
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: no column `u_q_r[4]` (and 1 more), which metadata.json lists; allowed: a time series of the columns of its metadata"]
+
+
+def test_an_infinite_duration_is_refused_naming_the_field(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = inf` passed the check of at least one control
+    period, and `hexadyn simulate` ended in an OverflowError traceback (the rows of an infinite
+    run)."""
+    path = tmp_path / "forever.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="inf"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress")
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {path}:10: field `scenario.duration_s` = inf: not a finite number; allowed: a finite duration >= 0.01 s (one control period)"], result.stderr
+
+
+def test_a_duration_too_long_for_an_integer_count_is_refused_as_too_large(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = 1e308` made the count of instants infinite:
+    an OverflowError traceback before the check of the memory a series takes."""
+    path = tmp_path / "long.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="1e308"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert len(result.stderr.splitlines()) == 1 and "Error: the time series would take about inf TB (inf instants x" in result.stderr, result.stderr
+
+
+def test_a_time_series_column_of_text_is_named_in_one_line(saved: Path, tmp_path: Path):
+    """Found by test_fuzz_cli.py: a time series column of strings reached the figures' sums:
+    a numpy casting traceback from `hexadyn plot`."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    table = pq.read_table(saved / "timeseries.parquet")
+    table = table.set_column(table.column_names.index("q_v[2]"), "q_v[2]", pa.array(["x"] * table.num_rows))
+    pq.write_table(table, broken / "timeseries.parquet")
+    result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: column `q_v[2]` holds string values; allowed: a time series of numbers"], (result.output, result.exception)

@@ -356,3 +356,12 @@ def test_bad_settings_and_missing_files_are_one_line(tmp_path, walk_study):
     assert_one_line_error(result, "--set gait.period_s: the study varies this field")
     result = CliRunner().invoke(cli, ["study", str(walk_study), "--set", "noequals"])
     assert result.exit_code == 2 and "KEY=VALUE" in result.stderr
+
+
+def test_a_fixed_field_of_a_toml_date_is_refused_in_one_line(tmp_path):
+    """Found by test_fuzz_cli.py: a `[fixed]` value TOML reads as a date reached the engine,
+    which has no dates: a TypeError traceback."""
+    study = tmp_path / "study.toml"
+    study.write_text('[study]\nscenario = "stand_six_legs"\noutputs = ["energy_electrical_j"]\n\n[fixed]\n"scenario.duration_s" = 1979-05-27\n\n[design]\nmethod = "grid"\nlevels = 2\n\n[parameters."model.mu"]\nrange = [0.3, 0.6]\n')
+    result = CliRunner().invoke(cli, ["study", str(study), "--no-plots", "--no-progress", "--out", str(tmp_path / "out")])
+    assert_one_line_error(result, f'{study}: field `fixed."scenario.duration_s"` = "1979-05-27": allowed: a value a scenario field holds')

@@ -43,7 +43,7 @@ _FAULT_OPTIONS = (
     click.option("--wrong-size", type=click.FloatRange(0, 1), default=0.0, show_default=True, help="Probability that a packet is cut short or lengthened."),
     click.option("--max-consecutive", type=click.IntRange(0), default=None, help="At most this many packets of one slave destroyed in a row (lost, corrupted, resized)."),
     click.option("--silent-slave", callback=_silent_slave, default=None, help="LEG:COMMANDS: that slave stops answering after so many commands."),
-    click.option("--seed", type=int, default=0, show_default=True, help="Seed of the fault draws."),
+    click.option("--seed", type=click.IntRange(0, 2**64 - 1), default=0, show_default=True, help="Seed of the fault draws."),
 )
 
 

@@ -277,7 +277,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         (robot, shown, text)
     };
     let period = robot.period();
-    c.check(h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a duration >= {period} s (one control period)")).map_err(e)?;
+    c.check(h.duration_s.is_finite() && h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a finite duration >= {period} s (one control period)")).map_err(e)?;
 
     // Model.
     let m = &raw.model;
