@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
@@ -38,6 +37,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from hexadyn import atomic, energy, plots
+from hexadyn.montecarlo.execution import ProcessPool
 from hexadyn.report import write_csv
 from hexadyn.runner import resolve_scenario, simulate
 from hexadyn.vocabulary import LEGS
@@ -145,6 +145,11 @@ def _run(scenario: str, base: Mapping[str, Any], model: str, velocity: float) ->
     }
 
 
+def _run_task(task: tuple[str, Mapping[str, Any], str, float]) -> dict[str, Any]:
+    """:func:`_run` of one (scenario, fields, model, velocity) task of the process pool."""
+    return _run(*task)
+
+
 def compare_friction(
     scenario: str | os.PathLike,
     velocities: Sequence[float] = DEFAULT_VELOCITIES,
@@ -178,21 +183,15 @@ def compare_friction(
     runs = [(m, v) for v in velocities for m in models]
     base = dict(overrides or {})
     _validate(path, base, runs)  # before any run starts
-    workers = max(1, min(workers or os.cpu_count() or 1, len(runs)))
     outputs = []
     bar = _progress_bar(progress, len(runs))
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run, os.fspath(path), base, m, v) for m, v in runs]
-        try:
-            for future in as_completed(futures):
-                outputs.append(future.result())
-                bar(len(outputs))
-        except BaseException:
-            for future in futures:
-                future.cancel()
-            raise
-        finally:
-            bar(None)
+    tasks = [(n, (os.fspath(path), base, m, v)) for n, (m, v) in enumerate(runs)]
+    try:
+        for _, output in ProcessPool(workers).capped(len(runs)).run(_run_task, tasks):
+            outputs.append(output)
+            bar(len(outputs))
+    finally:
+        bar(None)
     return _tabulate(Path(path).stem, outputs, velocities, list(models), _scenario_velocity(path, base))
 
 

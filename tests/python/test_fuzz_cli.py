@@ -54,7 +54,6 @@ from identify_logs import sawtooth_frame
 from conftest import shortened, sigint_as_in_a_terminal
 
 import hexadyn
-from hexadyn import compare
 from hexadyn.cli import INTERRUPTED, cli
 from hexadyn.link import LOOPBACK
 from hexadyn.montecarlo import campaign as campaign_module
@@ -604,7 +603,6 @@ def in_process(monkeypatch):
 
     monkeypatch.setattr(Figure, "savefig", lambda self, fname, *a, **k: Path(fname).write_bytes(b"") if isinstance(fname, (str, os.PathLike)) else None)
     monkeypatch.setattr(execution, "ProcessPoolExecutor", _serial_executor)
-    monkeypatch.setattr(compare, "ProcessPoolExecutor", _serial_executor)
     monkeypatch.setattr(campaign_module.Campaign, "_simulate", lambda self, *args: None)
     monkeypatch.setattr(campaign_module, "write_results", lambda table, folder: None)
     monkeypatch.setattr("hexadyn.identify.figures.figures", lambda ident: {})
