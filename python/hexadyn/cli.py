@@ -373,7 +373,7 @@ def scenarios() -> None:
 @click.option("--robot", type=click.Choice(["amru5", "phantomx"]), default=None, help="Without SCENARIO: the shipped robot whose campaign walk to run (amru5: validation_tripod_1_5cm, phantomx: phantomx_montecarlo) [default: amru5].")
 @click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
-@click.option("--variants", default=None, help="Comma-separated friction variants (default: every variant of the robot: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
+@click.option("--variants", default=None, help="Comma-separated friction variants: dry_viscous, dry_viscous_load (AMRU5), efficiency (default: those of Section 6.5 the robot has: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
 @click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
 @set_option()

@@ -8,6 +8,11 @@ applies: a negative viscous slope is not physical and is written as 0 (the measu
 a comment). The breakaway torques of the vertical joints are written as comments: the scenario
 fragment has no stiction key (the robot description holds them, Table 5.4).
 
+The efficiency law (:mod:`hexadyn.identify.efficiency`, from logs at two foot loads or more)
+has its own fragment, its no-load friction and efficiencies (mean over the legs), to use with
+``friction = "efficiency"``; the statistics of its efficiencies join the Monte Carlo inputs
+(the ``efficiency`` variant draws them).
+
 A serial robot's drives have one dry friction and one viscous slope for both senses
 (``tau_f_d``, ``f_v``): the fragment gives the mean of the two senses (the senses in a comment).
 
@@ -22,11 +27,12 @@ import math
 
 import numpy as np
 
+from hexadyn.identify.efficiency import EFFICIENCY_KEYS
 from hexadyn.identify.identification import Identification
 from hexadyn.identify.logs import LEGS
 from hexadyn.identify.tables import mean_sigma
 
-__all__ = ["leg_means", "joint_friction_fragment", "friction_stats", "friction_stats_toml"]
+__all__ = ["leg_means", "efficiency_means", "joint_friction_fragment", "efficiency_fragment", "friction_stats", "friction_stats_toml"]
 
 #: Fragment key -> (direction, attribute of the fit).
 STEADY_KEYS = {"tau_f_d_plus": (1, "tau_f_d"), "f_v_plus": (1, "f_v"), "tau_f_d_minus": (-1, "tau_f_d"), "f_v_minus": (-1, "f_v")}
@@ -56,9 +62,23 @@ def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
     return {k: v for k, v in out.items() if v}
 
 
+def efficiency_means(ident: Identification, joint: str) -> dict[str, list[float]]:
+    """Key of the efficiency law (``eta_forward``, ``tau_f_d_plus``...) -> the value of each leg
+    whose fit determined it."""
+    out: dict[str, list[float]] = {}
+    for fit in (f for f in ident.efficiency_fits if f.joint == joint):
+        for key, attr in EFFICIENCY_KEYS.items():
+            e = getattr(fit, attr)
+            if e is not None:
+                out.setdefault(key, []).append(e.value)
+    return out
+
+
 def _physical(key: str, value: float) -> float:
     """The Section 6.1 rule and the signs the scenario fields allow: only a dry friction or a
     load coefficient of the minus sense is negative."""
+    if key.startswith("eta_"):
+        return min(value, 1.0)  # 0 < eta <= 1; a fit that gives no eta > 0 is no efficiency law
     return min(value, 0.0) if key.endswith("_minus") and not key.startswith("f_v") else max(value, 0.0)
 
 
@@ -91,6 +111,25 @@ def joint_friction_fragment(ident: Identification) -> str:
     return "\n".join(lines) + "\n"
 
 
+def efficiency_fragment(ident: Identification) -> str:
+    """The ``[model.joint_friction.<joint>]`` tables of the efficiency law (TOML text): the
+    no-load friction and the efficiencies of the joints logged at two foot loads or more."""
+    lines = [
+        "# Efficiency-based friction identified by `hexadyn identify` from sawtooth logs at several",
+        "# foot loads (the thesis' prospects, Chapter 8): the no-load friction N of Eq. 6.1 and the",
+        "# forward / backward efficiencies, the mean over the legs. Use with [model] friction =",
+        '# "efficiency" (docs/identification.md); the other joints keep the robot\'s.',
+    ]
+    for joint in dict.fromkeys(f.joint for f in ident.efficiency_fits):
+        lines += ["", f"[model.joint_friction.{joint}]"]
+        for key, values in efficiency_means(ident, joint).items():
+            value = float(np.mean(values))
+            kept = _physical(key, value)
+            note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g}"
+            lines.append(f"{key} = {kept:.9g}{note}")
+    return "\n".join(lines) + "\n"
+
+
 def friction_stats(ident: Identification) -> dict[str, dict[str, float]]:
     """Scenario field -> {mu, sigma, legs} of every parameter identified on two legs or more."""
     stats = {}
@@ -100,6 +139,10 @@ def friction_stats(ident: Identification) -> dict[str, dict[str, float]]:
                 continue
             mu, sigma = mean_sigma(values)
             stats[f"model.joint_friction.{joint}.{key}"] = {"mu": mu, "sigma": sigma, "legs": len(values)}
+        for key, values in efficiency_means(ident, joint).items():
+            if key.startswith("eta_") and len(values) >= 2:
+                mu, sigma = mean_sigma(values)
+                stats[f"model.joint_friction.{joint}.{key}"] = {"mu": _physical(key, mu), "sigma": sigma, "legs": len(values)}
     return stats
 
 
