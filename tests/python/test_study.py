@@ -226,32 +226,34 @@ def test_failed_runs_are_stored_and_named(walk_study, tmp_path):
 
 
 WALK_PARAMETERS = ["gait.period_s", "gait.overlap", "gait.clearance_m", "gait.body_height_m"]
+#: The AMRU5 study's walk parameters: the PhantomX's and the spread of the footholds.
+AMRU5_WALK = WALK_PARAMETERS + ["gait.foothold_offset_m"]
 
 
 @pytest.mark.parametrize(
-    "file, robot, samples, lower, upper",
+    "file, robot, samples, walk, lower, upper",
     [
-        ("specific_resistance_1_5cm.toml", "amru5", 512, [8.0, 0.02, 0.04, 0.40], [16.0, 0.10, 0.10, 0.48]),
-        ("phantomx_gait.toml", "phantomx", 256, [0.6, 0.02, 0.02, 0.09], [1.6, 0.10, 0.045, 0.14]),
+        ("specific_resistance_1_5cm.toml", "amru5", 512, AMRU5_WALK, [8.0, 0.02, 0.04, 0.40, -0.03], [16.0, 0.10, 0.10, 0.48, 0.03]),
+        ("phantomx_gait.toml", "phantomx", 256, WALK_PARAMETERS, [0.6, 0.02, 0.02, 0.09], [1.6, 0.10, 0.045, 0.14]),
     ],
 )
-def test_shipped_study_is_valid(file, robot, samples, lower, upper):
+def test_shipped_study_is_valid(file, robot, samples, walk, lower, upper):
     """Its fields and outputs pass the engine (Study.create's run at the nominal values), its
     runs stay within the walk's ranges docs/studies.md states, and its friction is the robot's
     Monte Carlo campaign's (the [monte_carlo] table of its description, ``study_tables``)."""
     spec = read_study(STUDIES / file)
     tables = study_tables(FrictionDistributions.of_robot(robot))
-    dimension = len(WALK_PARAMETERS) + len(tables["parameters"])
+    dimension = len(walk) + len(tables["parameters"])
     assert spec.design.method == "sobol" and spec.design.samples == samples and run_count(spec) == samples * (dimension + 2)
-    assert [p.key for p in spec.parameters] == WALK_PARAMETERS + list(tables["parameters"])
+    assert [p.key for p in spec.parameters] == walk + list(tables["parameters"])
     assert spec.fixed == tables["fixed"]
-    for p in spec.parameters[len(WALK_PARAMETERS):]:
+    for p in spec.parameters[len(walk):]:
         expected = tables["parameters"][p.key]
         assert p.distribution == expected["distribution"] and (p.mean, p.std) == (expected["mean"], expected["std"])
         np.testing.assert_allclose(p.range, expected["range"], rtol=1e-9, atol=1e-9)
     x = Study.create(spec).samples
     assert x.shape == (samples * (dimension + 2), dimension)
-    assert (x[:, :4].min(axis=0) >= lower).all() and (x[:, :4].max(axis=0) <= upper).all()
+    assert (x[:, : len(walk)].min(axis=0) >= lower).all() and (x[:, : len(walk)].max(axis=0) <= upper).all()
 
 
 # ----------------------------------------------------------------------------------------------
