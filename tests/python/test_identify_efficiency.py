@@ -133,3 +133,23 @@ def test_monte_carlo_efficiency_variant_draws_the_identified_efficiencies(loaded
     one = Campaign.create("validation_tripod_1_5cm", velocities=[0.015], runs_per_velocity=1, variants=["efficiency"], friction_stats=stats)
     table = one.run(tmp_path / "mc", workers=1, progress=False)
     assert list(table["variant"]) == ["efficiency"] and 2.0 < float(table["specific_resistance_mean"].iloc[0]) < 6.0
+
+
+def test_serial_drive_fragment_and_servo_bias(tmp_path):
+    """The PhantomX femur campaign at 0, 0.25 and 0.5 kg with the efficiency law (eta_f =
+    0.70, eta_b = 0.55): the fragment takes the serial drive's keys (one dry friction and one
+    viscous slope, the mean of the senses); the backward efficiency within 2 %, the forward one
+    read low by the servo's current sampling (the method bias of docs/identification.md:
+    measured 0.649, 7 %)."""
+    import tomllib
+
+    from hexadyn.identify.fragment import efficiency_fragment
+
+    overrides = {"model.friction": "efficiency", "model.joint_friction.femur.eta_forward": 0.70, "model.joint_friction.femur.eta_backward": 0.55}
+    logs = [load_log(hexadyn.simulate("phantomx_identification_femur", out=tmp_path / f"{m:g}kg", progress=False, overrides={**overrides, "model.foot_load_kg": [m] * 6}).path) for m in (0.0, 0.25, 0.5)]
+    ident = identify(logs)
+    assert len(ident.efficiency_fits) == 6
+    femur = tomllib.loads(efficiency_fragment(ident))["model"]["joint_friction"]["femur"]
+    assert set(femur) == {"tau_f_d", "f_v", "eta_forward", "eta_backward"}
+    assert _relative(femur["eta_backward"], 0.55) < 0.02 and _relative(femur["tau_f_d"], 0.59) < 0.02
+    assert 0.60 < femur["eta_forward"] < 0.70

@@ -48,13 +48,19 @@ def _sense_means(ident: Identification, joint: str) -> dict[str, list[float]]:
     return {key: [mean_sigma([getattr(f, attr).value for f in ident.unloaded(joint, leg, direction)])[0] for leg in LEGS] for key, (direction, attr) in STEADY_KEYS.items()}
 
 
+def _drive_keys(ident: Identification, senses: dict[str, list[float]]) -> dict[str, list[float]]:
+    """Per-sense values (keys of Table 5.3, one per leg) under the keys of the robot's drives: a
+    serial drive's one dry friction and one viscous slope (:data:`SERIAL_KEYS`); the other
+    keys kept."""
+    if ident.leg_mechanism != "serial":
+        return senses
+    serial = {key: [(p + sign * m) / 2 for p, m in zip(senses[plus], senses[minus])] for key, (plus, minus, sign) in SERIAL_KEYS.items()}
+    return serial | {key: values for key, values in senses.items() if key not in STEADY_KEYS}
+
+
 def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
     """Fragment key -> the mean over the campaigns of each leg that has it."""
-    senses = _sense_means(ident, joint)
-    if ident.leg_mechanism == "serial":
-        out = {key: [(p + sign * m) / 2 for p, m in zip(senses[plus], senses[minus])] for key, (plus, minus, sign) in SERIAL_KEYS.items()}
-    else:
-        out = senses
+    out = _drive_keys(ident, _sense_means(ident, joint))
     out = {key: [v for v in values if not math.isnan(v)] for key, values in out.items()}
     if joint == "q_h":
         for key, (direction, attr) in LOAD_KEYS.items():
@@ -63,14 +69,14 @@ def leg_means(ident: Identification, joint: str) -> dict[str, list[float]]:
 
 
 def efficiency_means(ident: Identification, joint: str) -> dict[str, list[float]]:
-    """Key of the efficiency law (``eta_forward``, ``tau_f_d_plus``...) -> the value of each leg
-    whose fit determined it."""
-    out: dict[str, list[float]] = {}
-    for fit in (f for f in ident.efficiency_fits if f.joint == joint):
-        for key, attr in EFFICIENCY_KEYS.items():
-            e = getattr(fit, attr)
-            if e is not None:
-                out.setdefault(key, []).append(e.value)
+    """Key of the efficiency law (``tau_f_d_plus``... or a serial drive's ``tau_f_d``, ``f_v``;
+    ``eta_forward``, ``eta_backward``) -> the value of each leg whose fit determined it."""
+    fits = [f for f in ident.efficiency_fits if f.joint == joint]
+    out = _drive_keys(ident, {key: [getattr(f, attr).value for f in fits] for key, attr in EFFICIENCY_KEYS.items() if key in STEADY_KEYS})
+    for key in ("eta_forward", "eta_backward"):
+        values = [e.value for e in (getattr(f, EFFICIENCY_KEYS[key]) for f in fits) if e is not None]
+        if values:
+            out[key] = values
     return out
 
 
