@@ -17,6 +17,8 @@ from typing import Any, Callable, Sequence, TypeVar
 
 import click
 
+from hexadyn.fields import is_field_value
+
 __all__ = [
     "COMMON",
     "CommonOption",
@@ -142,16 +144,9 @@ def parse_set(values: Sequence[str]) -> dict[str, Any]:
             value = tomllib.loads(f"value = {literal.strip()}")["value"]
         except tomllib.TOMLDecodeError:
             value = None
-        if value is None or not _scenario_value(value):
+        if value is None or not is_field_value(value):
             raise ValueError(f"{item!r}: the value {literal.strip()!r} is not a TOML literal of a scenario field; allowed: a number, true or false, a quoted string (--set '{key}=\"...\"'), an array or an inline table of those")
         fields[key] = value
     return fields
 
 
-def _scenario_value(value: Any) -> bool:
-    """Whether a TOML value is one a scenario field takes (no dates nor times)."""
-    if isinstance(value, list):
-        return all(_scenario_value(v) for v in value)
-    if isinstance(value, dict):
-        return all(_scenario_value(v) for v in value.values())
-    return isinstance(value, (bool, int, float, str))

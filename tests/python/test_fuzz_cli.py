@@ -50,6 +50,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from identify_logs import sawtooth_frame
+from fuzz_edits import byte_edit
 
 from conftest import shortened, sigint_as_in_a_terminal
 
@@ -168,23 +169,7 @@ def mutated(draw, text: bytes, style: str) -> bytes:
     lines deleted or duplicated, a cut, a byte order mark."""
     for _ in range(draw(st.integers(1, 3))):
         edit = draw(st.sampled_from(["value", "value", "value", "flip", "delete_line", "duplicate_line", "truncate", "bom"]))
-        lines = text.split(b"\n")
-        if edit == "value":
-            text = draw(wrong_value(text, style))
-        elif edit == "flip" and text:
-            i = draw(st.integers(0, len(text) - 1))
-            text = text[:i] + bytes([draw(st.integers(0, 255))]) + text[i + 1 :]
-        elif edit == "delete_line":
-            del lines[draw(st.integers(0, len(lines) - 1))]
-            text = b"\n".join(lines)
-        elif edit == "duplicate_line":
-            i = draw(st.integers(0, len(lines) - 1))
-            lines.insert(i, lines[i])
-            text = b"\n".join(lines)
-        elif edit == "truncate":
-            text = text[: draw(st.integers(0, len(text)))]
-        elif edit == "bom":
-            text = b"\xef\xbb\xbf" + text
+        text = draw(wrong_value(text, style)) if edit == "value" else byte_edit(draw, text, edit)
     return text
 
 

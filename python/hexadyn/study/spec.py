@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, NoReturn
 
+from hexadyn.fields import is_field_value
+
 __all__ = ["DISTRIBUTIONS", "METHODS", "Design", "Parameter", "StudySpec", "parse_study", "read_study"]
 
 #: The designs: a full factorial grid, a Latin hypercube, Sobol' with Saltelli's scheme, Morris.
@@ -158,7 +160,7 @@ def parse_study(table: Mapping[str, Any], source: str = "study", *, name: str = 
     fixed = check.table("fixed", table.get("fixed", {}))
     for key, value in fixed.items():
         check.key("fixed", key)
-        if not _scenario_value(value):
+        if not is_field_value(value):
             check.bad(f"fixed.\"{key}\"", value, "a value a scenario field holds: a boolean, a number, a string, or a list or table of them (not a date or a time)")
     design = _design(check, check.table("design", table["design"]))
     parameters = check.table("parameters", table["parameters"])
@@ -273,15 +275,6 @@ def _range(check: _Checker, where: str, value: Any) -> tuple[float, float]:
 
 def _number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def _scenario_value(value: Any) -> bool:
-    """Whether a TOML value is one a scenario field can hold (TOML's dates and times are not)."""
-    if isinstance(value, list):
-        return all(_scenario_value(v) for v in value)
-    if isinstance(value, dict):
-        return all(_scenario_value(v) for v in value.values())
-    return isinstance(value, (bool, int, float, str))
 
 
 class _Checker:
