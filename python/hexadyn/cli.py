@@ -25,6 +25,7 @@ from hexadyn.options import (
     overwrite_option,
     set_option,
     strict_option,
+    warn_unhealthy,
     workers_option,
 )
 from hexadyn.runner import RESULTS_ROOT, free_results_folder
@@ -39,9 +40,6 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 USER_ERRORS: tuple[type[BaseException], ...] = (OSError, ValueError)
 #: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
 INTERRUPTED = 130
-#: Exit status of `--strict` (simulate, compare-friction, montecarlo) when a health check of a
-#: run failed.
-UNHEALTHY = 3
 
 
 class OneLineUsageError(click.UsageError):
@@ -149,7 +147,7 @@ def with_plot_options(f):
 @overwrite_option()
 @no_progress_option()
 @no_plots_option()
-@strict_option(UNHEALTHY)
+@strict_option()
 @with_plot_options
 def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, legs: tuple[int, ...], format_: tuple[str, ...]) -> None:
     """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
@@ -199,16 +197,7 @@ def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite:
         click.echo(f"  analysis    skipped {s['analysis_skipped']}")
     if (out / "plots").is_dir():
         click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
-    _warn(s["warnings"], strict)
-
-
-def _warn(warnings: list[str], strict: bool) -> None:
-    """Prints the failed health checks of the runs; with --strict, any ends the command with
-    status :data:`UNHEALTHY`."""
-    for warning in warnings:
-        click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
-    if warnings and strict:
-        raise SystemExit(UNHEALTHY)
+    warn_unhealthy(s["warnings"], strict)
 
 
 def _scenario(scenario: str | None, overrides: dict) -> hexadyn.Scenario:
@@ -309,7 +298,7 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @workers_option()
 @no_progress_option()
 @no_plots_option()
-@strict_option(UNHEALTHY)
+@strict_option()
 @figure_format_option()
 def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, strict: bool, format_: tuple[str, ...]) -> None:
     """Run the validation walk with each friction model at several velocities (Section 6.4).
@@ -352,7 +341,7 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
         click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
         for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
             click.echo(f"    {line}")
-    _warn(compare.warning_lines(result), strict)
+    warn_unhealthy(compare.warning_lines(result), strict)
 
 
 @cli.command()
@@ -380,7 +369,7 @@ def scenarios() -> None:
 @workers_option()
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @no_progress_option()
-@strict_option(UNHEALTHY)
+@strict_option()
 def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress, strict) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
@@ -430,9 +419,9 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     unhealthy = campaign.unhealthy(out)
     warnings = [] if unhealthy.empty else [warning_line(unhealthy, len(campaign.keys()), out)]
     if table["failed"].any():
-        _warn(warnings, strict=False)
+        warn_unhealthy(warnings, strict=False)
         raise click.ClickException(failure_line(campaign.failures(out), len(campaign.keys()), out))
-    _warn(warnings, strict)
+    warn_unhealthy(warnings, strict)
 
 
 @cli.command("export")

@@ -31,6 +31,8 @@ __all__ = [
     "parse_set",
     "set_option",
     "strict_option",
+    "UNHEALTHY",
+    "warn_unhealthy",
     "workers_option",
 ]
 
@@ -102,9 +104,22 @@ def no_plots_option() -> Callable[[F], F]:
     return click.option("--no-plots", cls=CommonOption, is_flag=True, help="Do not write the figures.")
 
 
-def strict_option(status: int) -> Callable[[F], F]:
-    """``--strict``: a failed health check of a run is an error, exit status `status`."""
-    return click.option("--strict", cls=CommonOption, is_flag=True, help=f"Exit with status {status} if a health check of a run fails (see `warnings` in summary.json).")
+#: Exit status of ``--strict`` when a health check of a run failed.
+UNHEALTHY = 3
+
+
+def strict_option() -> Callable[[F], F]:
+    """``--strict``: a failed health check of a run is an error, exit status :data:`UNHEALTHY`."""
+    return click.option("--strict", cls=CommonOption, is_flag=True, help=f"Exit with status {UNHEALTHY} if a health check of a run fails (see `warnings` in summary.json).")
+
+
+def warn_unhealthy(warnings: Sequence[str], strict: bool) -> None:
+    """Prints the failed health checks of the runs, one ``WARNING:`` line each on stderr; with
+    ``--strict``, any ends the command with status :data:`UNHEALTHY`."""
+    for warning in warnings:
+        click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
+    if warnings and strict:
+        raise SystemExit(UNHEALTHY)
 
 
 def set_option() -> Callable[[F], F]:

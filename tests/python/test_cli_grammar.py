@@ -16,10 +16,10 @@ from conftest import assert_one_line_error, shortened
 
 import hexadyn
 from hexadyn import _core, health
-from hexadyn.cli import UNHEALTHY, cli
+from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign
 from hexadyn.montecarlo.storage import RunKey
-from hexadyn.options import COMMON, CommonOption, parse_set
+from hexadyn.options import COMMON, UNHEALTHY, CommonOption, parse_set
 
 ROOT = Path(__file__).resolve().parents[2]
 CLI_DOC = ROOT / "docs" / "cli.md"

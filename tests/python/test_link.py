@@ -12,9 +12,10 @@ import sys
 import pytest
 from click.testing import CliRunner
 
-from hexadyn import Results, _core
+from hexadyn import Results, _core, health
 from hexadyn.cli import cli
 from hexadyn.link import LOOPBACK
+from hexadyn.options import UNHEALTHY
 from hexadyn.link.packets import COMMAND_SIZE, REPLY_SIZE, SERVO_VERSION, MotorCommands, PacketError, ServoCommands, SlaveReply, crc8_autosar, crc16_ibm3740
 
 from conftest import shortened
@@ -154,6 +155,27 @@ def test_robot_run_on_the_emulated_slaves_in_lock_step(tmp_path, name, joint):
     assert (out / "power.csv").is_file() and (out / "energy.csv").is_file()
     raw = _core.robot_run(str(scenario), str(LOOPBACK), emulated=True)
     assert raw["emulator"]["commands"] == 102 and raw["emulator"]["error"] is None  # the start, 100 updates, the stop
+
+
+def test_robot_run_checks_its_health_and_strict_exits_3(tmp_path, monkeypatch):
+    """The health checks of `hexadyn simulate` (`hexadyn.health.check`) on the summary of what
+    the master saw: kept in summary.json (`warnings`), printed as WARNING lines, and --strict
+    makes a failed one exit status 3. The master's summary has none of the model's figures the
+    checks read (energy balance, penetration, body pose), so a failed check is stood in for."""
+    scenario = shortened("stand_six_legs", tmp_path, 0.5)
+    args = ["robot", "run", str(scenario), "--link", "loopback", "--emulated", "--no-progress", "--no-plots"]
+    healthy = CliRunner().invoke(cli, [*args, "--strict", "--out", str(tmp_path / "healthy")])
+    assert healthy.exit_code == 0 and "WARNING" not in healthy.output, healthy.output
+    assert Results.load(tmp_path / "healthy").summary["warnings"] == []
+    seen = []
+    monkeypatch.setattr(health, "check", lambda summary: seen.append(summary["control_periods"]) or ["the limit switches cut a motor 1 times"])
+    for strict, status in [([], 0), (["--strict"], UNHEALTHY)]:
+        out = tmp_path / f"unhealthy{len(strict)}"
+        result = CliRunner().invoke(cli, [*args, *strict, "--out", str(out)])
+        assert result.exit_code == status, result.output
+        assert result.stderr == "WARNING: the limit switches cut a motor 1 times\n", result.stderr
+        assert Results.load(out).summary["warnings"] == ["the limit switches cut a motor 1 times"]
+    assert seen == [50, 50]
 
 
 def test_robot_emulate_answers_each_command_with_six_packets(tmp_path):

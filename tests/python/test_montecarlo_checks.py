@@ -20,7 +20,7 @@ from conftest import assert_one_line_error, shortened
 from scipy import stats
 
 from hexadyn import atomic, health
-from hexadyn.cli import UNHEALTHY, cli
+from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign, FrictionDistributions, draw_friction
 from hexadyn.montecarlo import execution
 from hexadyn.montecarlo.campaign import MAX_SIMULATIONS
@@ -28,6 +28,7 @@ from hexadyn.montecarlo.execution import ProcessPool, Ray
 from hexadyn.montecarlo.sampling import MIN_ACCEPTANCE
 from hexadyn.montecarlo.storage import DATABASE_FILE
 from hexadyn.montecarlo.tables import FIGURE_FILES, TABLE_FILE
+from hexadyn.options import UNHEALTHY
 
 FIELD = "model.joint_friction.q_v.tau_f_d_plus"  # physical values >= 0
 

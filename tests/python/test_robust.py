@@ -24,7 +24,8 @@ from click.testing import CliRunner
 
 import hexadyn
 from hexadyn import _core, atomic, compare, health, report, runner
-from hexadyn.cli import INTERRUPTED, UNHEALTHY, cli
+from hexadyn.cli import INTERRUPTED, cli
+from hexadyn.options import UNHEALTHY
 
 from conftest import shortened, sigint_as_in_a_terminal
 

@@ -5,8 +5,10 @@ validated with one-line errors."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import re
 import signal
 import sqlite3
 import subprocess
@@ -21,10 +23,12 @@ from click.testing import CliRunner
 from conftest import assert_one_line_error, sigint_as_in_a_terminal
 
 import hexadyn
+from hexadyn import health
 from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign, FrictionDistributions, study_tables
 from hexadyn.montecarlo.execution import SERIES_FIGURES, simulate_run
 from hexadyn.montecarlo.storage import DATABASE_FILE
+from hexadyn.options import UNHEALTHY
 from hexadyn.study import Study, parse_study, read_study
 from hexadyn.study.spec import run_count
 from hexadyn.study.study import RUNS_FILE, STUDY_FILE
@@ -223,6 +227,25 @@ def test_failed_runs_are_stored_and_named(walk_study, tmp_path):
     assert_one_line_error(result, "Error: 2 of 6 runs failed (run 4, 5); the first (run 4): ", "gait.period_s", "not retried")
     runs = pd.read_csv(tmp_path / "out" / RUNS_FILE)
     assert list(runs["status"]) == ["ok"] * 4 + ["failed"] * 2
+
+
+def test_unhealthy_runs_are_named_and_strict_exits_3(walk_study, tmp_path, monkeypatch):
+    """Every run's health checks (`hexadyn.health.check`, as `hexadyn simulate`'s) are kept in
+    the runs' warnings column; the runs that failed one are named on one WARNING line, and
+    --strict makes them exit status 3."""
+    args = ["study", str(walk_study), "--workers", "1", "--no-progress", "--no-plots"]
+    healthy = CliRunner().invoke(cli, [*args, "--strict", "--out", str(tmp_path / "healthy")])
+    assert healthy.exit_code == 0 and "WARNING" not in healthy.stderr, healthy.output
+    assert (pd.read_csv(tmp_path / "healthy" / RUNS_FILE)["warnings"] == "[]").all()
+    monkeypatch.setattr(health, "MAX_PENETRATION_RATIO", 0.0)  # every foot "too deep" (the workers are forked)
+    for strict, status in [([], 0), (["--strict"], UNHEALTHY)]:
+        out = tmp_path / f"unhealthy{len(strict)}"
+        result = CliRunner().invoke(cli, [*args, *strict, "--out", str(out)])
+        assert result.exit_code == status, result.output
+        pattern = r"WARNING: 4 of 4 runs failed a health check \(run 0, 1, 2, 3\); the first \(run 0\): a foot went [^\n]* into the ground[^\n]* \(column warnings of [^\n]*runs.csv\)\n"
+        assert re.fullmatch(pattern, result.stderr), result.stderr
+        warnings = [json.loads(w) for w in pd.read_csv(out / RUNS_FILE)["warnings"]]
+        assert all(len(w) == 1 and "into the ground" in w[0] for w in warnings)
 
 
 WALK_PARAMETERS = ["gait.period_s", "gait.overlap", "gait.clearance_m", "gait.body_height_m"]

@@ -10,7 +10,7 @@ import click
 
 import hexadyn
 from hexadyn.link import resolve_link
-from hexadyn.options import no_plots_option, no_progress_option, out_option, overwrite_option, set_option
+from hexadyn.options import no_plots_option, no_progress_option, out_option, overwrite_option, set_option, strict_option, warn_unhealthy
 
 LINK_HELP = "Link configuration file (addresses, period, timing, safety), or 'loopback' for the shipped one on 127.0.0.0/8."
 
@@ -84,10 +84,11 @@ def _stall(ctx: click.Context, param: click.Parameter, value: str | None) -> tup
 @overwrite_option()
 @no_progress_option()
 @no_plots_option()
+@strict_option()
 @click.option("--emulated", is_flag=True, help="Drive the six emulated slaves in this process instead of the robot, in lock-step on a virtual clock (free ports of the configured addresses, no real time: the same results on any machine).")
 @click.option("--stall-at", callback=_stall, default=None, help="T:MS, with --emulated: the master freezes T seconds after its start for MS milliseconds (virtual time), as a stopped process would: a rehearsal of a master overrun.")
 @_fault_options
-def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, emulated: bool, stall_at: tuple[float, float] | None, **faults) -> None:
+def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, emulated: bool, stall_at: tuple[float, float] | None, **faults) -> None:
     """Drive the robot with SCENARIO's controller through the link and save what the master saw.
 
     The master broadcasts the 18 motor commands every period, collects the six slave packets and
@@ -101,7 +102,7 @@ def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: 
     without timing), with the fault options of `robot emulate` and --stall-at to rehearse the
     safety stops. --set changes the scenario's fields (its description then says so).
     """
-    from hexadyn import _core, energy, report
+    from hexadyn import _core, energy, health, report
     from hexadyn.runner import free_results_folder
     from hexadyn.results import Results
 
@@ -128,6 +129,7 @@ def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: 
             raw = _core.robot_run(str(path), str(link_path), lambda t, _d: bar.update(max(0.0, t - bar.n)), fields, emulated=emulated, **rehearsal)
     results = Results.from_engine(raw, scenario_path=path)
     energy.add_energy_figures(results)
+    results.summary["warnings"] = health.check(results.summary)
     report.save(results, out, overwrite=overwrite)
     if not no_plots and report.skipped_analysis(results) is None:
         _save_plots(results, out / report.PLOTS_DIR, progress=not no_progress)
@@ -145,7 +147,9 @@ def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: 
         click.echo(f"    ... {len(raw['events']) - 10} more events")
     click.echo(f"  energy      electrical {s['energy_electrical_j']:.4g} J (sampled u i), max |u| {s['max_abs_voltage_v']:.2f} V")
     if raw["stop"] is not None:
+        warn_unhealthy(s["warnings"], strict=False)  # the safety stop's status 1 comes first
         raise click.ClickException(raw["stop"])
+    warn_unhealthy(s["warnings"], strict)
 
 
 def _save_plots(results, folder: Path, progress: bool) -> None:
