@@ -26,6 +26,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import tomlkit
+from tomlkit.items import Table
 
 from hexadyn.identify.efficiency import EFFICIENCY_KEYS
 from hexadyn.identify.identification import Identification
@@ -90,50 +92,73 @@ def _physical(key: str, value: float) -> float:
 
 def joint_friction_fragment(ident: Identification) -> str:
     """The ``[model.joint_friction.<joint>]`` tables of the identified joints (TOML text)."""
-    lines = [
-        "# Joint friction identified by `hexadyn identify` (thesis Sections 5.2-5.4): the mean over",
-        "# the legs and the campaigns, the same for every leg. Paste into a scenario file, or",
-        "# pass its keys as overrides (docs/identification.md).",
-    ]
+    doc = _document(
+        "Joint friction identified by `hexadyn identify` (thesis Sections 5.2-5.4): the mean over",
+        "the legs and the campaigns, the same for every leg. Paste into a scenario file, or",
+        "pass its keys as overrides (docs/identification.md).",
+    )
+    joints = tomlkit.table(is_super_table=True)
     for joint in ident.joints():
         means = leg_means(ident, joint)
         breakaways = [b for b in ident.breakaways if b.joint == joint]
         if not means and not breakaways:
             continue
-        lines += ["", f"[model.joint_friction.{joint}]"]
-        for key, values in means.items():
-            value = float(np.mean(values))
-            kept = _physical(key, value)
-            note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g} (Section 6.1)"
-            lines.append(f"{key} = {kept:.9g}{note}")
+        table = _means_table(means, "(Section 6.1)")
         if ident.leg_mechanism == "serial":
             senses = {key: float(np.nanmean(values)) for key, values in _sense_means(ident, joint).items()}
-            lines.append("# the two senses (Table 5.3), averaged above: " + ", ".join(f"{key} = {value:.6g}" for key, value in senses.items()))
+            table.add(tomlkit.comment("the two senses (Table 5.3), averaged above: " + ", ".join(f"{key} = {value:.6g}" for key, value in senses.items())))
         for b_dir, sign in ((1, "plus"), (-1, "minus")):
             for load in sorted({b.load_kg for b in breakaways}):
                 values = [b.tau_f_s for b in breakaways if b.direction == b_dir and b.load_kg == load and not b.reason]
                 if values:
-                    lines.append(f"# tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.{joint}.stiction]): {np.mean(values):.6g} N")
-    return "\n".join(lines) + "\n"
+                    table.add(tomlkit.comment(f"tau_f_s_{sign} at {load:g} kg (breakaway, Table 5.4; robot description [friction.{joint}.stiction]): {np.mean(values):.6g} N"))
+        joints.add(joint, table)
+    return _with_joint_friction(doc, joints)
 
 
 def efficiency_fragment(ident: Identification) -> str:
     """The ``[model.joint_friction.<joint>]`` tables of the efficiency law (TOML text): the
     no-load friction and the efficiencies of the joints logged at two foot loads or more."""
-    lines = [
-        "# Efficiency-based friction identified by `hexadyn identify` from sawtooth logs at several",
-        "# foot loads (the thesis' prospects, Chapter 8): the no-load friction N of Eq. 6.1 and the",
-        "# forward / backward efficiencies, the mean over the legs. Use with [model] friction =",
-        '# "efficiency" (docs/identification.md); the other joints keep the robot\'s.',
-    ]
+    doc = _document(
+        "Efficiency-based friction identified by `hexadyn identify` from sawtooth logs at several",
+        "foot loads (the thesis' prospects, Chapter 8): the no-load friction N of Eq. 6.1 and the",
+        "forward / backward efficiencies, the mean over the legs. Use with [model] friction =",
+        '"efficiency" (docs/identification.md); the other joints keep the robot\'s.',
+    )
+    joints = tomlkit.table(is_super_table=True)
     for joint in dict.fromkeys(f.joint for f in ident.efficiency_fits):
-        lines += ["", f"[model.joint_friction.{joint}]"]
-        for key, values in efficiency_means(ident, joint).items():
-            value = float(np.mean(values))
-            kept = _physical(key, value)
-            note = "" if kept == value else f"  # measured {value:.6g}: not physical, forced to {kept:g}"
-            lines.append(f"{key} = {kept:.9g}{note}")
-    return "\n".join(lines) + "\n"
+        joints.add(joint, _means_table(efficiency_means(ident, joint), ""))
+    return _with_joint_friction(doc, joints)
+
+
+def _document(*comments: str) -> tomlkit.TOMLDocument:
+    """A TOML document opening with `comments`, one line each."""
+    doc = tomlkit.document()
+    for line in comments:
+        doc.add(tomlkit.comment(line))
+    return doc
+
+
+def _means_table(means: dict[str, list[float]], rule: str) -> Table:
+    """A joint's table: the mean of each key's values (9 significant digits), a value the
+    physical signs refuse forced to its bound with the measured one in a comment."""
+    table = tomlkit.table()
+    for key, values in means.items():
+        value = float(np.mean(values))
+        kept = float(f"{_physical(key, value):.9g}")
+        table.add(key, kept)
+        if _physical(key, value) != value:
+            table[key].comment(f"measured {value:.6g}: not physical, forced to {kept:g} {rule}".rstrip())
+    return table
+
+
+def _with_joint_friction(doc: tomlkit.TOMLDocument, joints: Table) -> str:
+    """`doc` with the tables of `joints` under ``[model.joint_friction]``, as text."""
+    model = tomlkit.table(is_super_table=True)
+    model.add("joint_friction", joints)
+    doc.add(tomlkit.nl())
+    doc.add("model", model)
+    return tomlkit.dumps(doc)
 
 
 def friction_stats(ident: Identification) -> dict[str, dict[str, float]]:
@@ -154,13 +179,16 @@ def friction_stats(ident: Identification) -> dict[str, dict[str, float]]:
 
 def friction_stats_toml(ident: Identification) -> str:
     """:func:`friction_stats` as the file ``hexadyn montecarlo --friction-stats`` reads."""
-    lines = [
-        "# Friction statistics identified by `hexadyn identify` (Eq. 5.8-5.9, Table 6.7 layout):",
-        "# mu = mean of the leg means, sigma = (n - 1) standard deviation of the leg means.",
-        "# `hexadyn montecarlo SCENARIO --friction-stats THIS_FILE` draws from them.",
-        "",
-        "[friction_stats]",
-    ]
+    doc = _document(
+        "Friction statistics identified by `hexadyn identify` (Eq. 5.8-5.9, Table 6.7 layout):",
+        "mu = mean of the leg means, sigma = (n - 1) standard deviation of the leg means.",
+        "`hexadyn montecarlo SCENARIO --friction-stats THIS_FILE` draws from them.",
+    )
+    stats = tomlkit.table()
     for field, s in friction_stats(ident).items():
-        lines.append(f'"{field}" = {{ mu = {s["mu"]:.9g}, sigma = {s["sigma"]:.9g}, legs = {s["legs"]} }}')
-    return "\n".join(lines) + "\n"
+        entry = tomlkit.inline_table()
+        entry.update({"mu": float(f"{s['mu']:.9g}"), "sigma": float(f"{s['sigma']:.9g}"), "legs": s["legs"]})
+        stats.add(field, entry)
+    doc.add(tomlkit.nl())
+    doc.add("friction_stats", stats)
+    return tomlkit.dumps(doc)
