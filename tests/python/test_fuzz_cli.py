@@ -228,6 +228,10 @@ def _serial_executor(*args, **kwargs):
         def shutdown(self, *a, **k) -> None:
             pass
 
+        def terminate_workers(self) -> None:
+            """Nothing to stop: the tasks ran at their submission (Python 3.14's method, which
+            the pool's Ctrl-C handling calls)."""
+
         def __enter__(self):
             return self
 
