@@ -198,7 +198,7 @@ class Study:
 
     def _row(self, run_index: int, outcome: Mapping[str, Any]) -> dict[str, Any]:
         outputs = outcome.get("outputs", {})
-        values = {o: _number(outputs.get(o)) for o in self.spec.outputs}
+        values: dict[str, Any] = {o: _number(outputs.get(o)) for o in self.spec.outputs}
         if self.model_name == "scenario":
             values[WARNINGS_COLUMN] = json.dumps(outcome["warnings"]) if "warnings" in outcome else None
         return {"run_index": run_index, "status": outcome["status"], "error": outcome.get("error"), **self.parameters(run_index), **values}
