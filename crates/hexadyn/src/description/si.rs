@@ -201,9 +201,23 @@ impl RobotDescription {
             .map(|s| (s.tau_f_s_plus_n.mu[leg].value(), s.tau_f_s_minus_n.mu[leg].value()))
     }
 
+    /// n/n_0: this robot's reduction of `joint` over the one its friction was identified
+    /// with (`friction.identified_with_reductions`), 1 when they are the same drives. The
+    /// dry friction of [`Self::friction`] scales by it, the viscous coefficients by its square.
+    pub fn friction_reduction_ratio(&self, joint: PantographJoint) -> f64 {
+        let Some(n_0) = &self.friction.identified_with_reductions else { return 1.0 };
+        let identified = match joint {
+            PantographJoint::Rotation => n_0.n_r,
+            PantographJoint::Vertical => n_0.n_v_rad_per_m,
+            PantographJoint::Horizontal => n_0.n_h_rad_per_m,
+        };
+        self.reduction(joint) / identified
+    }
+
     /// Friction parameters of one joint of one leg in joint units, with the Section 6.1
     /// rules applied (negative viscous -> 0, missing stiction -> unloaded dry, vertical
-    /// stiction of the `vertical_stiction_load_kg` case, a_0 of Eq. 5.12 = unloaded dry).
+    /// stiction of the `vertical_stiction_load_kg` case, a_0 of Eq. 5.12 = unloaded dry),
+    /// referred to this robot's reductions ([`Self::friction_reduction_ratio`]).
     ///
     /// # Panics
     /// If `leg` is not 0..5.
@@ -245,17 +259,21 @@ impl RobotDescription {
                 a_1_minus,
             }
         });
+        // Dry (and load) friction by n/n_0, viscous by (n/n_0)^2: 1 on the identified drives.
+        let ratio = self.friction_reduction_ratio(joint);
+        let (dry, viscous_ratio) = (|v: f64| v * ratio, ratio * ratio);
+        let load_dependence = load_dependence.map(|a| LoadDependence { a_2_plus: dry(a.a_2_plus), a_2_minus: dry(a.a_2_minus), a_1_plus: dry(a.a_1_plus), a_1_minus: dry(a.a_1_minus) });
         JointFrictionParameters {
             leg,
             joint,
-            tau_f_d_plus,
-            tau_f_d_minus,
-            tau_f_s_plus,
-            tau_f_s_minus,
-            f_v_plus: viscous(vp.mu[leg]),
-            f_v_minus: viscous(vm.mu[leg]),
-            f_v_plus_measured: vp.mu[leg],
-            f_v_minus_measured: vm.mu[leg],
+            tau_f_d_plus: dry(tau_f_d_plus),
+            tau_f_d_minus: dry(tau_f_d_minus),
+            tau_f_s_plus: dry(tau_f_s_plus),
+            tau_f_s_minus: dry(tau_f_s_minus),
+            f_v_plus: viscous(vp.mu[leg]) * viscous_ratio,
+            f_v_minus: viscous(vm.mu[leg]) * viscous_ratio,
+            f_v_plus_measured: vp.mu[leg] * viscous_ratio,
+            f_v_minus_measured: vm.mu[leg] * viscous_ratio,
             q_st: (joint == PantographJoint::Vertical).then_some(f.lugre.q_st_v_m_per_s),
             sigma_0: f.lugre.sigma_0,
             sigma_1: f.lugre.sigma_1,
