@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use hexadyn::control::gait::controller::AepMode;
 use hexadyn::control::gait::pattern::FootCycle;
 use hexadyn::robot::model::FrictionModel;
-use hexadyn::description::{Robot, AMRU5_TOML};
+use hexadyn::description::{Robot, RobotDescription, AMRU5_TOML};
 use hexadyn::scenario::{run_scenario, run_scenario_until, specific_resistance, ControlMode, GaitLegs, HeadingSpec, LandingSpec, Override, Record, Scenario, ScenarioError, Summary, SummaryValue};
 use hexadyn::sim::NewmarkOptions;
 use hexadyn::hexapod::PantographJoint;
@@ -677,7 +677,8 @@ fn gait_runs_record_the_walk_deterministically() {
 
 /// Issue 18: every shipped walk respects its workspaces from the first step: no foot
 /// reference clamped by the inverse kinematics, none more than 1 µm outside its workspace
-/// cylinder on AMRU5 (the encoders' quantization of the start posture is below that); on a
+/// cylinder on AMRU5 (the encoders' quantization of the start posture is below that; on a
+/// variant, that times how much coarser its encoder counts are at the joints); on a
 /// serial robot, one count of its position sensors at the leg's full reach (the PhantomX's
 /// 0.29° at 0.25 m: 1.3 mm). The periodic
 /// walks only: the free gait's feet leave the flat-ground cylinder's height range by design
@@ -696,7 +697,13 @@ fn every_shipped_walk_keeps_its_feet_in_the_workspaces() {
                     let g = run.summary.gait.as_ref().expect("gait summary");
                     assert_eq!(g.clamped_ik_references, 0, "{}: {g:?}", s.name);
                     let bound = match &s.robot {
-                        Robot::Pantograph(_) => 1e-6,
+                        Robot::Pantograph(d) => {
+                            // AMRU5's 1 µm, times how much coarser the robot's encoder counts
+                            // are at the joints (the backdrivable drives' quarter ratios: 4).
+                            let amru5 = RobotDescription::amru5();
+                            let counts = |d: &RobotDescription, joint| f64::from(d.controller.encoder_impulses_per_rev) * d.reduction(joint);
+                            1e-6 * PantographJoint::ALL.into_iter().map(|j| counts(&amru5, j) / counts(d, j)).fold(1.0, f64::max)
+                        }
                         Robot::Serial(r) => {
                             let count = s.model().encoders.iter().map(|e| e.resolution()).fold(0.0, f64::max);
                             let reach = r.hexapod.legs.iter().map(|l| l.joints[1].origin.translation.norm() + l.joints[2].origin.translation.norm() + l.foot.norm()).fold(0.0, f64::max);
