@@ -12,7 +12,7 @@ Modules: :mod:`~hexadyn.montecarlo.sampling` (truncated Gaussian draws per run),
 (Table 6.8 and Fig. 6.20) and :mod:`~hexadyn.montecarlo.campaign` (the campaign itself).
 """
 
-from hexadyn.montecarlo.campaign import DEFAULT_SCENARIO, DEFAULT_SCENARIOS, VARIANTS, Campaign, run_campaign
+from hexadyn.montecarlo.campaign import DEFAULT_SCENARIO, DEFAULT_SCENARIOS, VARIANTS, Campaign, run_campaign, study_tables
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction
 from hexadyn.montecarlo.storage import CampaignStore, RunKey
 
@@ -26,4 +26,5 @@ __all__ = [
     "RunKey",
     "draw_friction",
     "run_campaign",
+    "study_tables",
 ]

@@ -23,22 +23,22 @@ influence, so only the ``dry_viscous`` variant.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import os
-from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence, Union
+from typing import Any, Iterable, Mapping, Sequence
 
 from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
-from hexadyn.montecarlo.execution import Executor, ProcessPool, Ray
+from hexadyn.montecarlo.execution import Executor, ProcessPool, Progress, Ray
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction, read_friction_stats
-from hexadyn.montecarlo.storage import CampaignStore, RunKey
+from hexadyn.montecarlo.storage import WARNINGS_COLUMN, CampaignStore, RunKey
 from hexadyn.montecarlo.tables import specific_resistance_table, write_results
 from hexadyn.runner import resolve_scenario
 
-__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "Campaign", "run_campaign", "variants_of"]
+__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "DEFAULT_VARIANTS", "Campaign", "run_campaign", "study_tables", "variant_fields", "variants_of"]
 
 #: Scenario of a campaign without an explicit one: the Table 6.2 validation walk.
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
@@ -46,23 +46,56 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 #: The campaign scenario of each shipped robot (``hexadyn montecarlo --robot NAME``).
 DEFAULT_SCENARIOS = {"amru5": DEFAULT_SCENARIO, "phantomx": "phantomx_montecarlo"}
 
-#: Friction variants of Section 6.5 -> whether the load influence of Eq. 5.12 is on.
-VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
+#: Friction variants -> the scenario fields selecting their model: those of Section 6.5,
+#: dry/viscous (Eq. 6.1) without and with the load influence of Eq. 5.12, and the transmission
+#: efficiency of the thesis' prospects (Chapter 8), whose no-load friction is drawn as the
+#: dry/viscous one and whose efficiencies are the robot's unless a friction statistics file
+#: gives their distributions (``hexadyn identify`` of loaded logs).
+VARIANTS = {
+    "dry_viscous": {"model.friction": "dry_viscous", "model.load_dependence": False},
+    "dry_viscous_load": {"model.friction": "dry_viscous", "model.load_dependence": True},
+    "efficiency": {"model.friction": "efficiency", "model.load_dependence": False},
+}
+#: The variants of a campaign that names none: Section 6.5's (those the robot allows).
+DEFAULT_VARIANTS = ("dry_viscous", "dry_viscous_load")
 
 #: The most simulations (runs x velocities x variants) a campaign may hold: 125 times the
 #: thesis' 8000 (1000 runs, 4 velocities, 2 variants), four and a half days of 60 s walks on
 #: one core at 0.4 s each; its list of runs takes about 100 MB.
 MAX_SIMULATIONS = 1_000_000
 
-#: ``progress`` argument of :meth:`Campaign.run`: a tqdm bar over the runs (True), nothing
-#: (False) or a callable ``progress(finished_runs, total_runs)`` called after each stored run.
-Progress = Union[bool, Callable[[int, int], object]]
+
+def variant_fields(variant: str) -> dict[str, Any]:
+    """The scenario fields that select a variant's friction model (:data:`VARIANTS`)."""
+    return dict(VARIANTS[variant])
+
+
+def drawn_by(distributions: FrictionDistributions, variant: str) -> dict[str, tuple[float, float]]:
+    """The Gaussians a variant's runs use: the load coefficients of Eq. 5.12 only with the
+    load influence, the efficiencies only with the efficiency law."""
+    load = VARIANTS[variant]["model.load_dependence"]
+    efficiency = VARIANTS[variant]["model.friction"] == "efficiency"
+    return {f: g for f, g in distributions.gaussians.items() if (load or f not in distributions.load_parameters) and (efficiency or f not in distributions.efficiency_parameters)}
+
+
+def study_tables(distributions: FrictionDistributions, variant: str = "dry_viscous") -> dict[str, dict[str, Any]]:
+    """The friction of a variant's runs as the ``[fixed]`` and ``[parameters]`` tables of a
+    design study (docs/studies.md): each drawn field a ``truncated_normal`` on its accepted
+    interval (:meth:`FrictionDistributions.accepted_interval`, the distribution
+    :func:`draw_friction` samples by rejection), a field of zero sigma and the robot's fixed
+    fields set as ``[fixed]`` with the variant's friction model. A study of these tables
+    samples what the campaign draws (its design instead of independent draws)."""
+    fields = drawn_by(distributions, variant)
+    parameters = {f: {"distribution": "truncated_normal", "range": list(distributions.accepted_interval(f)), "mean": mu, "std": sigma} for f, (mu, sigma) in fields.items() if sigma > 0}
+    fixed = {**variant_fields(variant), **distributions.fixed, **{f: mu for f, (mu, sigma) in fields.items() if sigma == 0}}
+    return {"fixed": fixed, "parameters": parameters}
 
 
 def variants_of(distributions: FrictionDistributions) -> tuple[str, ...]:
     """The variants a robot's set-up allows: the load influence needs drawn load coefficients
-    (AMRU5's horizontal joints, Eq. 5.12); a serial robot has ``dry_viscous`` only."""
-    return tuple(v for v, load in VARIANTS.items() if not load or distributions.load_parameters)
+    (AMRU5's horizontal joints, Eq. 5.12); a serial robot has ``dry_viscous`` and
+    ``efficiency``."""
+    return tuple(v for v, fields in VARIANTS.items() if not fields["model.load_dependence"] or distributions.load_parameters)
 
 
 @dataclass(frozen=True)
@@ -118,7 +151,7 @@ class Campaign:
         if not velocities or not all(math.isfinite(v) and v > 0 for v in velocities):
             raise ValueError(f"velocities = {list(velocities)}: need one or more finite velocities > 0 (m/s)")
         allowed = variants_of(distributions)
-        variants = tuple(allowed if variants is None else variants)
+        variants = tuple(v for v in allowed if v in DEFAULT_VARIANTS) if variants is None else tuple(variants)
         unknown = [v for v in variants if v not in allowed]
         if unknown or not variants or len(set(variants)) != len(variants):
             why = "" if len(allowed) == len(VARIANTS) else f" (no load influence on the legs of {distributions.robot})"
@@ -147,17 +180,15 @@ class Campaign:
         """The ``[model.joint_friction]`` fields of a run: the draw of (velocity, run) without
         the load coefficients for the variant without load influence, and the fixed values."""
         drawn = draw_friction(self.distributions, self.seed, key.velocity_index, key.run_index)
-        if not VARIANTS[key.variant]:
-            drawn = {k: v for k, v in drawn.items() if k not in self.distributions.load_parameters}
-        return {**drawn, **self.distributions.fixed}
+        used = drawn_by(self.distributions, key.variant)
+        return {**{k: v for k, v in drawn.items() if k in used}, **self.distributions.fixed}
 
     def overrides(self, key: RunKey) -> dict[str, Any]:
         """The scenario overrides of a run."""
         return {
             **self.fields,
             "scenario.name": f"{self.scenario_name}-{key.variant}-v{key.velocity_index}-r{key.run_index}",
-            "model.friction": "dry_viscous",
-            "model.load_dependence": VARIANTS[key.variant],
+            **variant_fields(key.variant),
             "gait.heading.vx_m_s": self.velocities_m_per_s[key.velocity_index],
             **self.friction(key),
         }
@@ -191,7 +222,8 @@ class Campaign:
         more workers than runs left to simulate. On Ctrl-C (KeyboardInterrupt, also raised by
         ``progress``) the running simulations are stopped and the finished ones are kept:
         running again resumes. Failed simulations are stored and counted in the table's
-        ``failed`` column (:meth:`failures` lists them).
+        ``failed`` column (:meth:`failures` lists them); so are the failed health checks of
+        each run (:meth:`unhealthy` lists the runs with any).
         """
         executor: Executor = Ray(ray, workers) if ray else ProcessPool(workers)
         keys = self.keys()
@@ -207,31 +239,35 @@ class Campaign:
     def failures(self, out: str | os.PathLike):
         """The failed simulations stored in the campaign folder ``out``: a DataFrame of
         ``variant``, ``velocity_m_s``, ``run_index`` and ``error``, in run order."""
-        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
-            runs = store.runs()
+        runs = self._runs(out)
         return runs.loc[runs["status"] != "ok", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
 
-    def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
-        from tqdm.auto import tqdm
+    def unhealthy(self, out: str | os.PathLike):
+        """The simulations stored in the campaign folder ``out`` that failed a health check
+        (:func:`hexadyn.health.check`): a DataFrame of ``variant``, ``velocity_m_s``,
+        ``run_index`` and ``warnings`` (the list of the failed checks), in run order. Runs
+        stored by a hexadyn that did not record the checks (``warnings`` NULL) are not listed."""
+        runs = self._runs(out)
+        runs = runs.loc[runs["status"] == "ok", ["variant", "velocity_m_s", "run_index", WARNINGS_COLUMN]]
+        runs[WARNINGS_COLUMN] = [json.loads(w) if isinstance(w, str) else [] for w in runs[WARNINGS_COLUMN]]  # NULL (NaN): not checked
+        return runs[runs[WARNINGS_COLUMN].map(bool)].reset_index(drop=True)
 
-        done = total - len(pending)
-        bar = tqdm(total=total, initial=done, desc=self.scenario_name, unit="run", disable=progress is not True)
+    def _runs(self, out: str | os.PathLike):
+        """Every run stored in the campaign folder ``out`` (:meth:`CampaignStore.runs`)."""
+        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
+            return store.runs()
+
+    def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
+        def stored(key: RunKey, outcome: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:
+            velocity = self.velocities_m_per_s[key.velocity_index]
+            store.add(key, velocity, self.friction(key), outcome)
+            return [(f"{key.variant}, V_x = {velocity} m/s, run {key.run_index}", outcome)]
+
         tasks: Iterable = ((key, self.overrides(key)) for key in pending)
         # execution.simulate_run as the module holds it when the campaign starts, so that a
         # benchmark's timed replacement is what the workers call.
         simulate = functools.partial(execution.simulate_run, os.fspath(self.scenario))
-        try:
-            with closing(executor.run(simulate, tasks)) as outcomes:
-                for key, outcome in outcomes:
-                    store.add(key, self.velocities_m_per_s[key.velocity_index], self.friction(key), outcome)
-                    done += 1
-                    bar.update()
-                    if outcome["status"] == "failed":
-                        bar.write(f"failed (stored, not retried): {key.variant}, V_x = {self.velocities_m_per_s[key.velocity_index]} m/s, run {key.run_index}: {outcome['error']}")
-                    if callable(progress):
-                        progress(done, total)
-        finally:
-            bar.close()
+        execution.run_and_store(executor, simulate, tasks, stored, name=self.scenario_name, total=total, done=total - len(pending), progress=progress)
 
 
 def run_campaign(

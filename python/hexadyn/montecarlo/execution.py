@@ -4,9 +4,9 @@ pool) or on Ray.
 Both executors take a picklable function and (key, payload) tasks, and yield (key,
 ``function(payload)``) as the tasks finish, in any order; the caller (the parent process, or the
 Ray driver) stores the results. A Monte Carlo campaign's function is :func:`simulate_run` of its
-scenario, whose outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
-:func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints) or ``{"status":
-"failed", "error": message}`` for a simulation the engine rejected (ValueError); any exception
+scenario, whose outcome is ``{"status": "ok", "summary": {...}, "warnings": [...]}`` (the
+entries of :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints, and the
+failed health checks of the run) or ``{"status": "failed", "error": message}`` for a simulation the engine rejected (ValueError); any exception
 stops the campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the
 tasks not finished yet and stops the workers.
 """
@@ -19,14 +19,19 @@ import signal
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence
+from contextlib import closing
+from typing import Any, Callable, Generator, Hashable, Iterable, Mapping, Protocol, Sequence, Union
 
 from hexadyn.montecarlo.storage import summary_columns
 
-__all__ = ["SERIES_FIGURES", "Executor", "ProcessPool", "Ray", "simulate_run"]
+__all__ = ["SERIES_FIGURES", "Executor", "ProcessPool", "Progress", "Ray", "run_and_store", "simulate_run"]
 
 #: A task: its key (handed back with its result) and the argument of the executor's function.
 Task = tuple[Hashable, Any]
+
+#: ``progress`` argument of a campaign's or a study's ``run``: a tqdm bar over the runs (True),
+#: nothing (False) or a callable ``progress(finished_runs, total_runs)`` called after each store.
+Progress = Union[bool, Callable[[int, int], object]]
 
 #: The figures of a run's summary that :func:`hexadyn.energy.add_energy_figures` computes from
 #: the time series (:func:`hexadyn.simulate` adds them; the engine's summary has the others).
@@ -42,13 +47,38 @@ IN_FLIGHT_PER_CPU = 2
 WALKS_PER_TASK = 4
 
 
+def run_and_store(executor: Executor, function: Callable[[Any], Any], tasks: Iterable[Task], store: Callable[[Hashable, Any], Sequence[tuple[str, Mapping[str, Any]]]], *, name: str, total: int, done: int, progress: Progress) -> None:
+    """Runs `tasks` on `executor` and hands each finished task's (key, result) to `store`, which
+    stores it and returns (label, outcome) of each run it held; the progress (a tqdm bar named
+    `name` over `total` runs, `done` of them stored before, or the `progress` callable) advances
+    by them, and each failed run is written as one line with its label. Closing on an exception
+    or Ctrl-C stops the workers (:meth:`Executor.run`)."""
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=total, initial=done, desc=name, unit="run", disable=progress is not True)
+    try:
+        with closing(executor.run(function, tasks)) as outcomes:
+            for key, result in outcomes:
+                runs = store(key, result)
+                done += len(runs)
+                bar.update(len(runs))
+                for label, outcome in runs:
+                    if outcome["status"] == "failed":
+                        bar.write(f"failed (stored, not retried): {label}: {outcome['error']}")
+                if callable(progress):
+                    progress(done, total)
+    finally:
+        bar.close()
+
+
 def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[str] | None = None) -> dict[str, Any]:
     """Runs one simulation and returns its outcome: the summary ``entries`` (default: the
     :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints, the split of E
-    per joint under the robot's joint names). The engine's summary alone (no time series)
-    unless an entry is one of :data:`SERIES_FIGURES`: then the run is :func:`hexadyn.simulate`'s,
-    series in memory. An entry the summary lacks is None."""
-    from hexadyn import _core
+    per joint under the robot's joint names) and the failed health checks of the run
+    (:func:`hexadyn.health.check`, as :func:`hexadyn.simulate` makes them). The engine's
+    summary alone (no time series) unless an entry is one of :data:`SERIES_FIGURES`: then the
+    run is :func:`hexadyn.simulate`'s, series in memory. An entry the summary lacks is None."""
+    from hexadyn import _core, health
     from hexadyn.vocabulary import Joints
 
     try:
@@ -58,11 +88,11 @@ def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[
             summary = simulate(scenario, progress=False, overrides=overrides).summary
         else:
             raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
-            summary = raw["summary"]
+            summary = {**raw["summary"], "warnings": health.check(raw["summary"])}
             entries = summary_columns(Joints.of_robot(raw["robot"]).names) if entries is None else entries
     except ValueError as exc:
         return {"status": "failed", "error": " ".join(str(exc).split())}
-    return {"status": "ok", "summary": {c: summary.get(c) for c in entries}}
+    return {"status": "ok", "summary": {c: summary.get(c) for c in entries}, "warnings": summary["warnings"]}
 
 
 def _several(function: Callable[[Any], Any]) -> Callable[[list[Any]], list[Any]]:

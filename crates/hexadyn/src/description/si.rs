@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
 use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
-use crate::physics::{DryViscous, LoadDependence, SeriesSpring};
+use crate::physics::{DryViscous, Efficiency, LoadDependence, SeriesSpring};
 
 impl MotorTable {
     /// L in H.
@@ -77,12 +77,21 @@ pub struct JointFrictionParameters {
     /// Load dependence of the dry friction (Table 5.5, Eq. 5.12; a_1^- after the
     /// `missing_a1_minus` rule): Some for q_h only.
     pub load_dependence: Option<LoadDependence>,
+    /// Forward and backward efficiencies of the transmission (`[friction.efficiency]`).
+    pub eta_forward: f64,
+    pub eta_backward: f64,
 }
 
 impl JointFrictionParameters {
     /// The dry/viscous law of Eq. 6.1 with these parameters (unloaded dry friction).
     pub fn dry_viscous(&self) -> DryViscous {
         DryViscous { tau_f_d_plus: self.tau_f_d_plus, tau_f_d_minus: self.tau_f_d_minus, f_v_plus: self.f_v_plus, f_v_minus: self.f_v_minus, epsilon: self.epsilon }
+    }
+
+    /// The efficiency law with these efficiencies on the no-load friction of Eq. 6.1 (the
+    /// unloaded dry and viscous friction of Table 5.3).
+    pub fn efficiency(&self) -> Efficiency {
+        Efficiency { eta_forward: self.eta_forward, eta_backward: self.eta_backward, no_load: self.dry_viscous() }
     }
 
     /// Dry friction under a foot load of `load_kg` (Eq. 5.12 with a_0 the unloaded dry
@@ -270,6 +279,11 @@ impl RobotDescription {
                 a_1_minus,
             }
         });
+        let efficiency = match joint {
+            PantographJoint::Rotation => f.efficiency.q_r,
+            PantographJoint::Vertical => f.efficiency.q_v,
+            PantographJoint::Horizontal => f.efficiency.q_h,
+        };
         // Dry (and load) friction by n/n_0, viscous by (n/n_0)^2: 1 on the identified drives.
         let ratio = self.friction_reduction_ratio(joint);
         let (dry, viscous_ratio) = (|v: f64| v * ratio, ratio * ratio);
@@ -292,6 +306,8 @@ impl RobotDescription {
             delta_d: f.lugre.delta_d,
             epsilon: f.lugre.dry_viscous_epsilon,
             load_dependence,
+            eta_forward: efficiency.eta_forward,
+            eta_backward: efficiency.eta_backward,
         }
     }
 }

@@ -505,9 +505,50 @@ pub struct FrictionTable {
     #[serde(default)]
     pub identified_with_reductions: Option<IdentifiedReductionsTable>,
     pub lugre: LuGreTable,
+    /// The transmission efficiencies of the efficiency law (`friction = "efficiency"`); ideal
+    /// transmissions (Eq. 6.1 alone) where left out.
+    #[serde(default)]
+    pub efficiency: EfficiencyTable,
     pub q_r: RotationalFrictionTable,
     pub q_v: VerticalFrictionTable,
     pub q_h: HorizontalFrictionTable,
+}
+
+/// `[friction.efficiency]`: the forward and backward efficiencies of each joint kind's
+/// transmission, every leg alike ([`crate::physics::Efficiency`]; the no-load friction is the
+/// joint's Table 5.3 dry/viscous friction).
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EfficiencyTable {
+    #[serde(default)]
+    pub q_r: TransmissionEfficiency,
+    #[serde(default)]
+    pub q_v: TransmissionEfficiency,
+    #[serde(default)]
+    pub q_h: TransmissionEfficiency,
+}
+
+/// The two efficiencies of a transmission, each in (0, 1]; 1 (ideal) where left out.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TransmissionEfficiency {
+    /// η_f: the motor drives the load.
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_forward: f64,
+    /// η_b: the load drives the motor.
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_backward: f64,
+}
+
+impl Default for TransmissionEfficiency {
+    fn default() -> Self {
+        TransmissionEfficiency { eta_forward: ideal(), eta_backward: ideal() }
+    }
+}
+
+/// The efficiency of a lossless transmission.
+pub(super) fn ideal() -> f64 {
+    1.0
 }
 
 /// `[friction.identified_with_reductions]`: the global reductions n_0 of the drives the

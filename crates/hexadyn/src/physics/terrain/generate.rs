@@ -54,7 +54,9 @@ pub fn terraces(xs: &[f64], ys: &[f64], height: impl Fn(usize, usize) -> f64) ->
     t
 }
 
-/// A ground z = f(x), piecewise linear through (`xs`, `zs`), over y in [y0, y1].
+/// A ground z = f(x), piecewise linear through (`xs`, `zs`), over y in [y0, y1]; `xs` is
+/// non-decreasing, and a repeated x makes a vertical face (a riser or a drop), facing the lower
+/// side.
 pub fn profile(xs: &[f64], zs: &[f64], (y0, y1): (f64, f64)) -> Triangles {
     let mut t = Triangles::default();
     for (&x, &z) in xs.iter().zip(zs) {
@@ -63,6 +65,15 @@ pub fn profile(xs: &[f64], zs: &[f64], (y0, y1): (f64, f64)) -> Triangles {
     for k in 0..xs.len() as u32 - 1 {
         let (a, b, c, d) = (2 * k, 2 * k + 2, 2 * k + 3, 2 * k + 1);
         t.faces.extend([[a, b, c], [a, c, d]]);
+    }
+    t
+}
+
+/// `t` turned by `azimuth` (rad) about the vertical axis through the origin.
+pub fn rotated(mut t: Triangles, azimuth: f64) -> Triangles {
+    let (sin, cos) = azimuth.sin_cos();
+    for v in &mut t.vertices {
+        *v = [cos * v[0] - sin * v[1], sin * v[0] + cos * v[1], v[2]];
     }
     t
 }
@@ -118,6 +129,12 @@ pub fn rough(rms: f64, seed: u64) -> Triangles {
     RoughGround { rms, seed, length_scale: 1.0, flat_radius: ROUGH_FLAT_RADIUS, full_radius: ROUGH_FULL_RADIUS }.triangles()
 }
 
+/// The smooth step (3u² − 2u³) from 0 within `flat` (m) of the origin to 1 beyond `full`.
+fn fade(r: f64, flat: f64, full: f64) -> f64 {
+    let u = ((r - flat) / (full - flat)).clamp(0.0, 1.0);
+    u * u * (3.0 - 2.0 * u)
+}
+
 /// The parameters of a [`rough`] ground for a robot of another size.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughGround {
@@ -149,11 +166,6 @@ impl RoughGround {
             .collect();
         // Each unit cosine has mean square 1/2: the sum of 64 has RMS 4 (independent phases).
         let scale = rms / (waves.len() as f64 / 2.0).sqrt();
-        let (flat, full) = (self.flat_radius, self.full_radius);
-        let fade = |r: f64| {
-            let u = ((r - flat) / (full - flat)).clamp(0.0, 1.0);
-            u * u * (3.0 - 2.0 * u)
-        };
         let (spacing, origin, (nx, ny)) = (0.1 * s, [-2.0 * s, -6.0 * s], (161, 121));
         let heights: Vec<Vec<f64>> = (0..ny)
             .map(|j| {
@@ -161,13 +173,48 @@ impl RoughGround {
                     .map(|i| {
                         let (x, y) = (origin[0] + i as f64 * spacing, origin[1] + j as f64 * spacing);
                         let z: f64 = waves.iter().map(|&(kx, ky, phase)| (kx * x + ky * y + phase).cos()).sum();
-                        scale * z * fade(x.hypot(y))
+                        scale * z * fade(x.hypot(y), self.flat_radius, self.full_radius)
                     })
                     .collect()
             })
             .collect();
         grid_triangles(origin, spacing, &heights)
     }
+}
+
+/// A boulder field: spherical caps on flat ground, heights on a 2.5 cm grid over x in [-2, 6] m,
+/// y in [-2.5, 2.5] m, scaled to the RMS height `rms` (m) where the field is full, faded to flat
+/// ground as [`rough`] (flat within 0.6 m of the origin, full beyond 1.2 m).
+///
+/// INTERPRETATION (issue 37's boulder fields of RMS 1-3 cm; the thesis has none): 3 boulders per
+/// square metre at uniform positions, base radius uniform in [5, 20] cm and height 0.3-0.7 times
+/// it before the scaling, drawn from `seed`; the ground is the highest cap over each point. The
+/// caps' steep flanks and the flat ground between them are what distinguishes them from the
+/// smooth waves of [`rough`] ground.
+pub fn boulders(rms: f64, seed: u64) -> Triangles {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (spacing, origin, (nx, ny)) = (0.025, [-2.0, -2.5], (321, 201));
+    let area = (nx - 1) as f64 * spacing * (ny - 1) as f64 * spacing;
+    // (x, y, sphere radius, height of its centre): a cap of base radius b and height h lies on
+    // the sphere of radius (b² + h²) / 2h centred h − ρ below the ground.
+    let caps: Vec<[f64; 4]> = (0..(3.0 * area).round() as usize)
+        .map(|_| {
+            let (x, y) = (rng.random_range(origin[0]..origin[0] + 8.0), rng.random_range(origin[1]..origin[1] + 5.0));
+            let b = rng.random_range(0.05..0.2);
+            let h = b * rng.random_range(0.3..0.7);
+            let rho = (b * b + h * h) / (2.0 * h);
+            [x, y, rho, h - rho]
+        })
+        .collect();
+    let cap_height = |x: f64, y: f64| caps.iter().map(|&[cx, cy, rho, zc]| (rho * rho - (x - cx).powi(2) - (y - cy).powi(2)).max(0.0).sqrt() + zc).fold(0.0, f64::max);
+    let points = |j: usize, i: usize| (origin[0] + i as f64 * spacing, origin[1] + j as f64 * spacing);
+    let raw: Vec<Vec<f64>> = (0..ny).map(|j| (0..nx).map(|i| { let (x, y) = points(j, i); cap_height(x, y) }).collect()).collect();
+    let full: Vec<f64> = (0..ny).flat_map(|j| (0..nx).map(move |i| (j, i))).filter(|&(j, i)| { let (x, y) = points(j, i); x.hypot(y) >= ROUGH_FULL_RADIUS }).map(|(j, i)| raw[j][i]).collect();
+    let mean = full.iter().sum::<f64>() / full.len() as f64;
+    let measured = (full.iter().map(|z| (z - mean).powi(2)).sum::<f64>() / full.len() as f64).sqrt();
+    let scale = rms / measured;
+    let heights: Vec<Vec<f64>> = (0..ny).map(|j| (0..nx).map(|i| { let (x, y) = points(j, i); scale * raw[j][i] * fade(x.hypot(y), ROUGH_FLAT_RADIUS, ROUGH_FULL_RADIUS) }).collect()).collect();
+    grid_triangles(origin, spacing, &heights)
 }
 
 /// The rough ground of the PhantomX Mark II's free gait (`phantomx_free_gait_rough.toml`):
