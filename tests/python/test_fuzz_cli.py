@@ -556,7 +556,7 @@ def assert_clean_end(args: list[str], result, interrupted: bool) -> str:
 
         raise AssertionError(shown + "\n" + "".join(traceback.format_exception(result.exception)))
     assert "Traceback" not in result.output, (shown, result.output)
-    lines = [line for line in result.stderr.replace("\r", "\n").splitlines() if line.strip() and not line.startswith(ANNOUNCEMENTS)]
+    lines = [line for line in result.stderr.replace("\r", "\n").splitlines() if line.strip() and not line.startswith(ANNOUNCEMENTS) and not PROGRESS.match(line)]
     if interrupted and result.exit_code == INTERRUPTED:
         assert len(lines) <= 1 and all(line.startswith("Interrupted") for line in lines), (shown, result.stderr)
         return "interrupted"
@@ -570,6 +570,9 @@ def assert_clean_end(args: list[str], result, interrupted: bool) -> str:
 #: What a command says on stderr while it runs, before it may fail or be stopped: the slave
 #: emulator announces itself (it then serves until Ctrl-C, its exit status 130).
 ANNOUNCEMENTS = ("Emulating the six slaves of ",)
+# A progress bar's line (tqdm: "desc:  40%|████      | 8/20 ..."): what a run interrupted after
+# the bound (a slow, loaded machine) has drawn before its one line.
+PROGRESS = re.compile(r"(?!Error|Interrupted)[^|]*: *\d+%\|")
 
 
 @pytest.fixture
