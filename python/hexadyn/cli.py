@@ -25,6 +25,7 @@ from hexadyn.options import (
     overwrite_option,
     set_option,
     strict_option,
+    warn_unhealthy,
     workers_option,
 )
 from hexadyn.runner import RESULTS_ROOT, free_results_folder
@@ -39,8 +40,6 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 USER_ERRORS: tuple[type[BaseException], ...] = (OSError, ValueError)
 #: Exit status after Ctrl-C (128 + SIGINT, as shells report it).
 INTERRUPTED = 130
-#: Exit status of `simulate --strict` when a health check failed.
-UNHEALTHY = 3
 
 
 class OneLineUsageError(click.UsageError):
@@ -148,7 +147,7 @@ def with_plot_options(f):
 @overwrite_option()
 @no_progress_option()
 @no_plots_option()
-@strict_option(UNHEALTHY)
+@strict_option()
 @with_plot_options
 def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, legs: tuple[int, ...], format_: tuple[str, ...]) -> None:
     """Run SCENARIO (a scenario file or a shipped scenario name) and save its results.
@@ -191,26 +190,20 @@ def simulate(scenario: str | None, overrides: dict, out: Path | None, overwrite:
             f"  gait        {s['gait_pattern']}, {s['gait_switches']} gait switches, {s['clamped_ik_references']} clamped IK references, "
             f"at least {s['min_feet_on_ground']} feet on the ground"
         )
-    if report.in_memory(results):
+    if report.skipped_analysis(results) is None:
         _echo_power(results)
         _echo_ground_detection(results)
     else:
         click.echo(f"  analysis    skipped {s['analysis_skipped']}")
     if (out / "plots").is_dir():
         click.echo(f"  plots       {out / 'plots'} ({len(list((out / 'plots').iterdir()))} files)")
-    for warning in s["warnings"]:
-        click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
-    if s["warnings"] and strict:
-        raise SystemExit(UNHEALTHY)
+    warn_unhealthy(s["warnings"], strict)
 
 
 def _scenario(scenario: str | None, overrides: dict) -> hexadyn.Scenario:
-    """SCENARIO (default: :data:`DEFAULT_SCENARIO`) with the fields of --set, each checked by
-    the engine as it is set."""
-    run = hexadyn.Scenario.load(scenario or DEFAULT_SCENARIO)
-    for field, value in overrides.items():
-        run.set(field, value)
-    return run
+    """SCENARIO (default: :data:`DEFAULT_SCENARIO`) with the fields of --set, checked by the
+    engine."""
+    return hexadyn.Scenario.load(scenario or DEFAULT_SCENARIO).update(overrides)
 
 
 def _echo_power(results: hexadyn.Results) -> None:
@@ -275,7 +268,12 @@ def plot(folder: Path, legs: tuple[int, ...], format_: tuple[str, ...], no_progr
     results = hexadyn.Results.load(folder)
     if not report.in_memory(results):
         raise ValueError(f"{folder}: the time series ({results.shape[0]} instants) is too long to plot in memory; plot a part of it from Python (Results.read_columns)")
-    figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
+    try:
+        figures = report.plot(results, folder / "plots", legs=legs, formats=format_, progress=not no_progress)
+    except ValueError as exc:  # what the figures cannot be drawn from, said of the folder
+        raise ValueError(f"{folder}: {exc}") from exc
+    except KeyError as exc:  # a column the figures need, missing from a damaged time series
+        raise ValueError(f"{folder}: the time series has no column {exc}; allowed: the columns the run that wrote the folder recorded") from exc
     click.echo(f"Plots: {folder / 'plots'} ({len(figures)} figures x {len(format_)} formats)")
 
 
@@ -293,23 +291,26 @@ def _parse_velocities(ctx: click.Context, param: click.Parameter, value: str | N
 @cli.command("compare-friction")
 @click.argument("scenario", required=False, default=None)
 @click.option("--velocities", default="1,1.5,2,2.5", show_default=True, callback=_parse_velocities, help="Forward velocities V_x in cm/s (Table 6.2, Fig. 6.19), comma-separated.")
-@click.option("--models", default=None, help="Friction models, comma-separated (default: all four: none, dry_viscous, lugre, dry_viscous_load).")
+@click.option("--models", default=None, help="Friction models, comma-separated (default: all five: none, dry_viscous, lugre, dry_viscous_load, efficiency).")
 @set_option()
 @out_option("Output folder (default: results/compare_friction_<scenario name>, numbered if it exists).")
 @overwrite_option()
 @workers_option()
 @no_progress_option()
 @no_plots_option()
+@strict_option()
 @figure_format_option()
-def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, format_: tuple[str, ...]) -> None:
+def compare_friction(scenario: str | None, velocities: tuple[float, ...], models: str | None, overrides: dict, out: Path | None, overwrite: bool, workers: int | None, no_progress: bool, no_plots: bool, strict: bool, format_: tuple[str, ...]) -> None:
     """Run the validation walk with each friction model at several velocities (Section 6.4).
 
     SCENARIO (default: the validation case of Table 6.2) is run without friction, with the
-    dry/viscous model, with LuGre, and with the dry/viscous model plus the load dependence of the
-    horizontal joints, at each velocity, in parallel. Writes the averaged power per actuator and
+    dry/viscous model, with LuGre, with the dry/viscous model plus the load dependence of the
+    horizontal joints, and with the transmission-efficiency law, at each velocity, in parallel. Writes the averaged power per actuator and
     model (Tables 6.3-6.6), the robot power and specific resistance versus velocity with the fit
     P = alpha + beta V_x (Fig. 6.19) as CSV tables and plots. --set changes the scenario's fields
-    for every run (the friction model and the velocity are set over them).
+    for every run (the friction model and the velocity are set over them). Every run checks its
+    own health (as `hexadyn simulate`'s): a failed check is printed and kept in the `warnings`
+    column of robot_power.csv, and makes --strict exit with status 3.
     """
     from hexadyn import compare, energy
 
@@ -336,10 +337,11 @@ def compare_friction(scenario: str | None, velocities: tuple[float, ...], models
         click.echo(f"    {line}")
     if result.fit.empty:
         click.echo("  fit P = alpha + beta V_x (Eq. 6.8) skipped: it needs at least two velocities")
-        return
-    click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
-    for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
-        click.echo(f"    {line}")
+    else:
+        click.echo("  fit P = alpha + beta V_x (Eq. 6.8), xi -> beta / (m g) (Eq. 6.11):")
+        for line in result.fit.to_string(float_format=lambda v: f"{v:9.4g}").splitlines():
+            click.echo(f"    {line}")
+    warn_unhealthy(compare.warning_lines(result), strict)
 
 
 @cli.command()
@@ -360,14 +362,15 @@ def scenarios() -> None:
 @click.option("--robot", type=click.Choice(["amru5", "phantomx"]), default=None, help="Without SCENARIO: the shipped robot whose campaign walk to run (amru5: validation_tripod_1_5cm, phantomx: phantomx_montecarlo) [default: amru5].")
 @click.option("--runs", type=int, default=None, help="Runs per velocity (default: the robot's [monte_carlo], 1000).")
 @click.option("--velocities", default=None, callback=_parse_velocities, help="Forward velocities V_x in cm/s, comma-separated (default: the robot's [monte_carlo], 1,1.5,2,2.5).")
-@click.option("--variants", default=None, help="Comma-separated friction variants (default: every variant of the robot: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
+@click.option("--variants", default=None, help="Comma-separated friction variants: dry_viscous, dry_viscous_load (AMRU5), efficiency (default: those of Section 6.5 the robot has: dry_viscous,dry_viscous_load on AMRU5, dry_viscous on serial legs).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the friction draws.")
 @click.option("--friction-stats", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None, help="Friction Gaussians identified by `hexadyn identify` (its friction_stats.toml) instead of Table 6.7.")
 @set_option()
 @workers_option()
 @click.option("--ray", "ray_address", default=None, metavar="ADDRESS", help='Run on a Ray cluster ("local": a Ray instance started here).')
 @no_progress_option()
-def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress) -> None:
+@strict_option()
+def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_stats, overrides, workers, ray_address, no_progress, strict) -> None:
     """Monte Carlo over the joint friction uncertainty (Section 6.5): Table 6.8 and Fig. 6.20.
 
     Simulates SCENARIO (default: the validation walk validation_tripod_1_5cm, or with --robot
@@ -377,10 +380,12 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     every run (the drawn friction and the velocity are set over them). Rerunning the same command resumes an
     interrupted campaign. Writes campaign.json, runs.sqlite, specific_resistance.csv/.png/.pdf
     to --out. A campaign with failed simulations (stored, not retried) ends with one line
-    naming them and exit status 1.
+    naming them and exit status 1. Every run checks its own health (as `hexadyn simulate`'s,
+    kept in runs.sqlite): the runs that failed a check are named in one WARNING line, and
+    --strict then exits with status 3.
     """
     from hexadyn.montecarlo import DEFAULT_SCENARIOS, Campaign
-    from hexadyn.montecarlo.tables import failure_line
+    from hexadyn.montecarlo.tables import failure_line, warning_line
 
     if scenario is not None and robot is not None:
         raise click.BadParameter(f"--robot {robot} with the scenario {scenario}: the scenario names its robot; give one of them", param_hint="--robot")
@@ -411,8 +416,12 @@ def montecarlo(scenario, out, robot, runs, velocities, variants, seed, friction_
     click.echo(f"Specific resistance xi = E/(m g l) (Table 6.8), {campaign.scenario_name}, seed {seed}:")
     click.echo(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
     click.echo(f"Results: {out} (specific_resistance.csv, specific_resistance.png, specific_resistance.pdf, runs.sqlite)")
+    unhealthy = campaign.unhealthy(out)
+    warnings = [] if unhealthy.empty else [warning_line(unhealthy, len(campaign.keys()), out)]
     if table["failed"].any():
+        warn_unhealthy(warnings, strict=False)
         raise click.ClickException(failure_line(campaign.failures(out), len(campaign.keys()), out))
+    warn_unhealthy(warnings, strict)
 
 
 @cli.command("export")

@@ -3,7 +3,8 @@ Fig. 6.19).
 
 One scenario (by default the validation case of Table 6.2) is run with each friction model of
 :data:`MODELS` (no friction, dry/viscous Eq. 6.1, LuGre, dry/viscous with the load dependence of
-the horizontal joints Eq. 5.12) at each velocity V_x, in parallel on the local cores. The
+the horizontal joints Eq. 5.12, and the transmission-efficiency law of the thesis' prospects,
+Chapter 8) at each velocity V_x, in parallel on the local cores. The
 scenario fields are changed through the overrides of :func:`hexadyn.simulate`; the step period
 and the number of steps stay those of the scenario, so the step length grows with V_x as in
 Section 6.3.
@@ -15,8 +16,9 @@ Outputs (:func:`compare_friction`, written atomically by :func:`save`):
   rows legs 0-5 and total, one column per model);
 - ``robot_power.csv``: per velocity and model the averaged robot power, the electrical and
   friction energies, the distance walked, the specific resistance ξ (Eq. 6.6), the friction
-  share (friction work over electrical energy) and the share of the power due to friction
-  (1 - P_none / P_model, Section 6.6: "more than 80 %");
+  share (friction work over electrical energy), the failed health checks of the run
+  (``warnings``, :func:`hexadyn.health.check`, separated by ``; ``, empty for a healthy run) and
+  the share of the power due to friction (1 - P_none / P_model, Section 6.6: "more than 80 %");
 - ``fit.csv``: per model α and β of P = α + β V_x (Eq. 6.8) and the asymptote β / (m g) of ξ;
 - ``plots/``: Fig. 6.19 (a) power and (b) specific resistance versus velocity with the fits,
   and the averaged power per actuator and model (Tables 6.3-6.6 as bar charts).
@@ -26,7 +28,6 @@ from __future__ import annotations
 
 import math
 import os
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
@@ -36,6 +37,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from hexadyn import atomic, energy, plots
+from hexadyn.montecarlo.execution import ProcessPool
 from hexadyn.report import write_csv
 from hexadyn.runner import resolve_scenario, simulate
 from hexadyn.vocabulary import LEGS
@@ -46,6 +48,7 @@ MODELS: dict[str, dict[str, Any]] = {
     "dry_viscous": {"model.friction": "dry_viscous", "model.load_dependence": False},
     "lugre": {"model.friction": "lugre", "model.load_dependence": False},
     "dry_viscous_load": {"model.friction": "dry_viscous", "model.load_dependence": True},
+    "efficiency": {"model.friction": "efficiency", "model.load_dependence": False},
 }
 #: Legend labels of the models.
 MODEL_LABELS = {
@@ -53,16 +56,19 @@ MODEL_LABELS = {
     "dry_viscous": "dry/viscous",
     "lugre": "LuGre",
     "dry_viscous_load": "dry/viscous + load",
+    "efficiency": "efficiency",
 }
 #: Colour and marker of each model in every figure.
-MODEL_COLOURS = {"none": "#1f4e79", "dry_viscous": "#c0392b", "lugre": "#2e8b57", "dry_viscous_load": "#e67e22"}
-MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_load": "D"}
+MODEL_COLOURS = {"none": "#1f4e79", "dry_viscous": "#c0392b", "lugre": "#2e8b57", "dry_viscous_load": "#e67e22", "efficiency": "#7d3c98"}
+MODEL_MARKERS = {"none": "o", "dry_viscous": "s", "lugre": "^", "dry_viscous_load": "D", "efficiency": "v"}
 #: Velocities V_x of Table 6.2 and Fig. 6.19 (m/s).
 DEFAULT_VELOCITIES = (0.01, 0.015, 0.02, 0.025)
 #: Scenario field of the forward velocity.
 VELOCITY_FIELD = "gait.heading.vx_m_s"
 #: Columns of the fit table (no rows with a single velocity: the fit needs two).
 FIT_COLUMNS = ("alpha_w", "beta_n", "xi_asymptote", "mass_kg")
+#: Separates the failed health checks of a run in the ``warnings`` column.
+WARNING_SEPARATOR = "; "
 POWER_FILE = "power_by_model.csv"
 ROBOT_FILE = "robot_power.csv"
 FIT_FILE = "fit.csv"
@@ -75,6 +81,7 @@ __all__ = [
     "figures",
     "joint_tables",
     "save",
+    "warning_lines",
 ]
 
 
@@ -85,7 +92,8 @@ class Comparison:
     scenario: str
     #: Averaged power per (velocity_m_s, model, leg) and joint type q_r, q_v, q_h, total (W).
     power: pd.DataFrame
-    #: One row per (velocity_m_s, model): robot power, energies, distance, ξ, friction shares.
+    #: One row per (velocity_m_s, model): robot power, energies, distance, ξ, friction shares,
+    #: the run's failed health checks (``warnings``).
     robot: pd.DataFrame
     #: One row per model: alpha_w, beta_n, xi_asymptote (β / (m g)), mass_kg.
     fit: pd.DataFrame
@@ -132,8 +140,14 @@ def _run(scenario: str, base: Mapping[str, Any], model: str, velocity: float) ->
             "mass_kg": s["robot_mass_kg"],
             "specific_resistance": s.get("specific_resistance", np.nan),
             "friction_share": s["friction_share"],
+            "warnings": WARNING_SEPARATOR.join(s["warnings"]),
         },
     }
+
+
+def _run_task(task: tuple[str, Mapping[str, Any], str, float]) -> dict[str, Any]:
+    """:func:`_run` of one (scenario, fields, model, velocity) task of the process pool."""
+    return _run(*task)
 
 
 def compare_friction(
@@ -169,21 +183,15 @@ def compare_friction(
     runs = [(m, v) for v in velocities for m in models]
     base = dict(overrides or {})
     _validate(path, base, runs)  # before any run starts
-    workers = max(1, min(workers or os.cpu_count() or 1, len(runs)))
     outputs = []
     bar = _progress_bar(progress, len(runs))
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run, os.fspath(path), base, m, v) for m, v in runs]
-        try:
-            for future in as_completed(futures):
-                outputs.append(future.result())
-                bar(len(outputs))
-        except BaseException:
-            for future in futures:
-                future.cancel()
-            raise
-        finally:
-            bar(None)
+    tasks = [(n, (os.fspath(path), base, m, v)) for n, (m, v) in enumerate(runs)]
+    try:
+        for _, output in ProcessPool(workers).capped(len(runs)).run(_run_task, tasks):
+            outputs.append(output)
+            bar(len(outputs))
+    finally:
+        bar(None)
     return _tabulate(Path(path).stem, outputs, velocities, list(models), _scenario_velocity(path, base))
 
 
@@ -239,6 +247,13 @@ def _tabulate(name: str, outputs: list[dict], velocities: list[float], models: l
     fit = pd.DataFrame.from_dict(fit_rows, orient="index", columns=list(FIT_COLUMNS)).rename_axis("model")
     table_velocity = own_velocity if own_velocity in velocities else velocities[0]
     return Comparison(name, power, robot, fit, table_velocity)
+
+
+def warning_lines(comparison: Comparison) -> list[str]:
+    """The runs that failed a health check, one line each naming the model and the velocity
+    (empty: every run healthy)."""
+    robot = comparison.robot
+    return [f"friction model {model}, V_x = {velocity:g} m/s: {warnings}" for (velocity, model), warnings in robot["warnings"].items() if warnings]
 
 
 def joint_tables(comparison: Comparison, velocity: float | None = None) -> dict[str, pd.DataFrame]:

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from hexadyn import _core
-from hexadyn.vocabulary import LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column
+from hexadyn.vocabulary import LANDING, LEGS, SUPPORT, SWING, TAKEOFF, actuator, actuator_column, leg_column, phase_codes
 
 if TYPE_CHECKING:
     from hexadyn.results import Results
@@ -53,6 +53,7 @@ __all__ = [
     "TOTAL",
     "add_energy_figures",
     "averaged_power",
+    "control_period",
     "energy_breakdown",
     "energy_figures",
     "fit_power_velocity",
@@ -77,12 +78,21 @@ def _require(frame: pd.DataFrame, columns: Sequence[str], what: str) -> None:
         raise ValueError(f"{what} needs the time-series columns {', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}, which these results lack")
 
 
+def control_period(results: Results) -> float:
+    """The control period Δt (s) of the results' time series; ValueError saying what is wrong
+    with a time axis the analyses and the figures cannot use (a single instant, times not
+    increasing by equal steps)."""
+    return _period(results.timeseries.index)
+
+
 def _period(t: pd.Index) -> float:
     """The control period Δt (s) of a time series with equally spaced instants."""
     steps = np.diff(t.to_numpy())
     if steps.size == 0:
         raise ValueError("the time series has a single instant: no control period to compute powers over")
     dt = float(np.median(steps))
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"the time series' instants do not increase (median step {dt:g} s); allowed: times increasing by the control period")
     if not np.allclose(steps, dt, rtol=1e-6, atol=1e-12):
         raise ValueError(f"the time series is not equally spaced (steps from {steps.min():g} to {steps.max():g} s)")
     return dt
@@ -122,12 +132,13 @@ def foot_phases(results: Results) -> pd.DataFrame | None:
 
     Same rows as :func:`power`; column l is the phase of leg l in which the controller
     commanded the period's voltage (``phase[l]`` of the previous row, see the module doc).
+    ValueError naming the column if a value is not a phase code.
     """
     ts = results.timeseries
     columns = [leg_column("phase", leg) for leg in LEGS]
     if not all(c in ts.columns for c in columns):
         return None
-    codes = ts[columns].to_numpy()[:-1].round().astype(int)
+    codes = phase_codes(ts[columns].to_numpy()[:-1], columns, ts.index).astype(int)
     return pd.DataFrame(codes, index=ts.index[1:], columns=list(LEGS))
 
 
@@ -299,7 +310,8 @@ def energy_figures(results: Results) -> dict[str, float]:
     duration = float(t[-1] - t[0])
     mass = robot_mass(results)
     figures = {
-        "average_power_w": e_el / duration,
+        # A run stopped at its first instant (a safety stop of `hexadyn robot run`) has no duration.
+        "average_power_w": e_el / duration if duration > 0 else math.nan,
         "energy_mechanical_j": float(b["mechanical_j"].sum()),
         "friction_share": float(b["friction_j"].sum()) / e_el if e_el else math.nan,
         "joule_share": float(b["joule_j"].sum()) / e_el if e_el else math.nan,

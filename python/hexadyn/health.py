@@ -3,7 +3,7 @@
 :func:`check` reads a run's summary (the engine's totals and diagnostics) and returns one line
 per failed check; :func:`hexadyn.simulate` stores them as the summary's ``warnings`` (in
 ``summary.json``), ``hexadyn simulate`` prints them prominently and ``--strict`` makes them an
-error. A run with accepted but extreme settings (a loose integrator tolerance, a stiff or
+error (``compare-friction`` and ``montecarlo`` check each of their runs alike). A run with accepted but extreme settings (a loose integrator tolerance, a stiff or
 slippery ground) can finish with exit status 0 and still be numerical nonsense; these checks
 catch what a reader of the figures would catch:
 

@@ -17,6 +17,8 @@ from typing import Any, Callable, Sequence, TypeVar
 
 import click
 
+from hexadyn.fields import is_field_value
+
 __all__ = [
     "COMMON",
     "CommonOption",
@@ -29,6 +31,8 @@ __all__ = [
     "parse_set",
     "set_option",
     "strict_option",
+    "UNHEALTHY",
+    "warn_unhealthy",
     "workers_option",
 ]
 
@@ -100,9 +104,22 @@ def no_plots_option() -> Callable[[F], F]:
     return click.option("--no-plots", cls=CommonOption, is_flag=True, help="Do not write the figures.")
 
 
-def strict_option(status: int) -> Callable[[F], F]:
-    """``--strict``: a failed health check of a run is an error, exit status `status`."""
-    return click.option("--strict", cls=CommonOption, is_flag=True, help=f"Exit with status {status} if a health check of a run fails (see `warnings` in summary.json).")
+#: Exit status of ``--strict`` when a health check of a run failed.
+UNHEALTHY = 3
+
+
+def strict_option() -> Callable[[F], F]:
+    """``--strict``: a failed health check of a run is an error, exit status :data:`UNHEALTHY`."""
+    return click.option("--strict", cls=CommonOption, is_flag=True, help=f"Exit with status {UNHEALTHY} if a health check of a run fails (see `warnings` in summary.json).")
+
+
+def warn_unhealthy(warnings: Sequence[str], strict: bool) -> None:
+    """Prints the failed health checks of the runs, one ``WARNING:`` line each on stderr; with
+    ``--strict``, any ends the command with status :data:`UNHEALTHY`."""
+    for warning in warnings:
+        click.secho(f"WARNING: {warning}", fg="red", bold=True, err=True)
+    if warnings and strict:
+        raise SystemExit(UNHEALTHY)
 
 
 def set_option() -> Callable[[F], F]:
@@ -142,16 +159,9 @@ def parse_set(values: Sequence[str]) -> dict[str, Any]:
             value = tomllib.loads(f"value = {literal.strip()}")["value"]
         except tomllib.TOMLDecodeError:
             value = None
-        if value is None or not _scenario_value(value):
+        if value is None or not is_field_value(value):
             raise ValueError(f"{item!r}: the value {literal.strip()!r} is not a TOML literal of a scenario field; allowed: a number, true or false, a quoted string (--set '{key}=\"...\"'), an array or an inline table of those")
         fields[key] = value
     return fields
 
 
-def _scenario_value(value: Any) -> bool:
-    """Whether a TOML value is one a scenario field takes (no dates nor times)."""
-    if isinstance(value, list):
-        return all(_scenario_value(v) for v in value)
-    if isinstance(value, dict):
-        return all(_scenario_value(v) for v in value.values())
-    return isinstance(value, (bool, int, float, str))

@@ -244,13 +244,18 @@ def gait_diagram(results: Results) -> Figure:
     return fig
 
 
+#: The columns of the trajectory figure: the body path and its reference, and the feet (for the
+#: footholds). A `hexadyn robot run` has the reference only: the robot has no navigation system.
+TRAJECTORY_COLUMNS = {"X", "Y", "X_ref", "Y_ref", *(leg_column(c, leg) for c in ("foot_x", "foot_y") for leg in LEGS)}
+
+
 def trajectory_figure(results: Results) -> Figure:
     """The body path in the ground plane (X, Y) with its reference and the footholds (equal
     axes), and below it the XY tracking error over time."""
     ts = results.timeseries
     phases = energy.foot_phases(results)
-    if not {"X_ref", "Y_ref"} <= set(ts.columns) or phases is None:
-        raise ValueError("trajectory: these results have no body reference X_ref, Y_ref (not a walking scenario)")
+    if not TRAJECTORY_COLUMNS <= set(ts.columns) or phases is None:
+        raise ValueError("trajectory: these results have no body path X, Y with its reference X_ref, Y_ref and the feet (not a walking scenario, or a robot run: no navigation system)")
     t = ts.index.to_numpy()
     with style():
         fig = Figure(figsize=(6.3, 4.4))
@@ -420,7 +425,7 @@ def figures(results: Results, legs: Sequence[int] = DEFAULT_LEGS) -> dict[str, F
     out = {f"leg{leg}_{j}": joint_figure(results, leg, j) for leg in legs for j in results.joints.names}
     if energy.foot_phases(results) is not None:
         out["gait_diagram"] = gait_diagram(results)
-    if "X_ref" in results.timeseries.columns:
+    if TRAJECTORY_COLUMNS <= set(results.timeseries.columns):
         out["trajectory"] = trajectory_figure(results)
     if "body_clearance" in results.timeseries.columns:
         out["posture"] = posture_figure(results)

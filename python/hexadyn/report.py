@@ -59,7 +59,7 @@ def save(
     """
     if not overwrite:
         atomic.refuse_existing(folder, "results folder")
-    figures = _figures(results, legs) if plots and in_memory(results) else None  # before anything is written
+    figures = _figures(results, legs) if plots and skipped_analysis(results) is None else None  # before anything is written
     save_run(lambda tmp: results, folder, overwrite=overwrite, plots=plots, legs=legs, formats=formats, figures=figures, progress=progress)
     return Path(folder)
 
@@ -77,8 +77,9 @@ def save_run(
 ) -> Results:
     """:func:`save` of the results ``run(tmp)`` returns, called with the temporary folder so
     that it may stream its time series there (:func:`hexadyn.simulate`). The power table and
-    the figures need the series in memory: they are left out, with a note in the summary
-    (``analysis_skipped``), for a series over :data:`hexadyn.results.IN_MEMORY_LIMIT_BYTES`."""
+    the figures need the series in memory and a control period: they are left out, with a note
+    in the summary (``analysis_skipped``, :func:`skipped_analysis`), for a series over
+    :data:`hexadyn.results.IN_MEMORY_LIMIT_BYTES` or of a single instant."""
     target = Path(folder)
     if not overwrite:
         atomic.refuse_existing(target, "results folder")
@@ -87,9 +88,10 @@ def save_run(
     def write(tmp: Path) -> None:
         results = run(tmp)
         kept.append(results)
-        small = in_memory(results)
+        skipped = skipped_analysis(results)
+        small = skipped is None
         if not small:
-            results.summary["analysis_skipped"] = f"{POWER_FILE} and the figures: the time series ({results.shape[0]} instants) is too long to analyse in memory"
+            results.summary["analysis_skipped"] = f"{POWER_FILE} and the figures: {skipped}"
         results.write(tmp)
         if small:
             write_csv(tmp / POWER_FILE, energy.averaged_power(results))
@@ -111,6 +113,17 @@ def save_run(
 def in_memory(results: Results) -> bool:
     """Whether the time series is small enough for the analyses in memory."""
     return results.series_bytes <= IN_MEMORY_LIMIT_BYTES
+
+
+def skipped_analysis(results: Results) -> str | None:
+    """Why the analyses in memory (the power table, the figures) cannot be made of the results,
+    or None if they can: a series too long for memory, or of a single instant (a robot run
+    stopped at its first control period), which has no period to average powers over."""
+    if not in_memory(results):
+        return f"the time series ({results.shape[0]} instants) is too long to analyse in memory"
+    if results.shape[0] < 2:
+        return "the time series has a single instant: no control period to average powers over"
+    return None
 
 
 def plot(
@@ -144,6 +157,7 @@ def write_csv(path: Path, table: pd.DataFrame) -> None:
 
 
 def _figures(results: Results, legs: Sequence[int] | None) -> dict[str, Figure]:
+    energy.control_period(results)  # a time axis the figures can be drawn on, or ValueError
     return plotting.figures(results, plotting.DEFAULT_LEGS if legs is None else legs)
 
 

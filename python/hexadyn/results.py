@@ -257,13 +257,19 @@ class Results:
     @classmethod
     def load(cls, folder: str | os.PathLike) -> "Results":
         """Reads a results folder (written by :func:`hexadyn.report.save`); the time series is
-        read on first access. Raises ValueError naming the file for a broken folder."""
+        read on first access. Raises ValueError naming the file for a broken folder, or for a
+        time series without a column its metadata lists (the analyses go by the metadata)."""
         folder = Path(folder)
         metadata = read_metadata(folder)
         summary = _read_json_object(folder / SUMMARY_FILE, "the run's summary")
-        inputs.check_input(_existing(folder / TIMESERIES_FILE, "the Parquet file of the time series"), limit=None)
+        units = metadata.get("units", {})
+        with open_series(folder / TIMESERIES_FILE) as file:
+            held = set(file.schema_arrow.names)
+        missing = [c for c in units if c not in held]
+        if missing:
+            raise ValueError(f"{folder / TIMESERIES_FILE}: no column `{missing[0]}`{f' (and {len(missing) - 1} more)' if len(missing) > 1 else ''}, which {METADATA_FILE} lists; allowed: a time series of the columns of its metadata")
         metadata.pop("columns", None)
-        return cls(None, metadata.get("units", {}), summary, metadata, path=folder)
+        return cls(None, units, summary, metadata, path=folder)
 
 
 class SeriesWriter:
@@ -393,7 +399,10 @@ def read_metadata(folder: str | os.PathLike) -> dict[str, Any]:
 def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
     """The Parquet file of a time series, opened as an input file
     (:func:`hexadyn.inputs.open_input`) and closed on leaving; ValueError naming it if it is
-    missing or not a Parquet file."""
+    missing, not a Parquet file, holds a column twice (a column would then be a table) or a
+    column of other values than numbers."""
+    import collections
+
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -402,6 +411,12 @@ def open_series(path: Path) -> Iterator["pq.ParquetFile"]:
             file = pq.ParquetFile(source)
         except (pa.ArrowException, OSError) as exc:
             raise ValueError(f"{path}: not a readable time series: {exc}") from None
+        repeated = [(name, n) for name, n in collections.Counter(file.schema_arrow.names).items() if n > 1]
+        if repeated:
+            raise ValueError(f"{path}: column `{repeated[0][0]}` appears {repeated[0][1]} times; allowed: a time series of distinct columns")
+        other = next((f for f in file.schema_arrow if not (pa.types.is_floating(f.type) or pa.types.is_integer(f.type))), None)
+        if other is not None:
+            raise ValueError(f"{path}: column `{other.name}` holds {other.type} values; allowed: a time series of numbers")
         yield file
 
 

@@ -122,7 +122,7 @@ def simulate(
     info = _core.load_scenario(os.fspath(path), overrides)  # invalid: nothing is created
     if out is None and save:
         out = free_results_folder(info["name"])
-    rows = round(info["duration_s"] / info["period_s"]) + 1
+    rows = info["duration_s"] / info["period_s"] + 1  # a float: a finite duration may still overflow an integer
 
     def finish(results: Results) -> Results:
         energy.add_energy_figures(results)
@@ -162,11 +162,11 @@ def simulate(
     return report.save_run(record, out, overwrite=overwrite, plots=plots, legs=legs, formats=formats, progress=progress is True)
 
 
-def _refuse_beyond(rows: int, columns: int, limit: float, where: str, advice: str) -> None:
+def _refuse_beyond(rows: float, columns: int, limit: float, where: str, advice: str) -> None:
     """Refuses a series of `rows` x `columns` 8-byte values larger than `limit` bytes."""
     estimate = 8 * rows * columns
     if estimate > limit:
-        raise ValueError(f"the time series would take about {_size(estimate)} ({rows} instants x {columns} columns x 8 bytes), more than {where} ({_size(limit)}); {advice}")
+        raise ValueError(f"the time series would take about {_size(estimate)} ({rows:.0f} instants x {columns} columns x 8 bytes), more than {where} ({_size(limit)}); {advice}")
 
 
 def _size(n: float) -> str:

@@ -21,7 +21,7 @@ import copy
 import errno
 import os
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 from hexadyn import _core
 from hexadyn.results import Results
@@ -95,7 +95,13 @@ class Scenario:
         Values: bool, int, float, str, lists and dicts of those. Raises ValueError (TypeError
         for a value of another type) naming the field, the value and what is allowed; the
         scenario is then unchanged."""
-        return self._update({field: copy.deepcopy(value)})
+        return self.update({field: value})
+
+    def update(self, fields: Mapping[str, Any]) -> Scenario:
+        """Sets several fields at once (``{"gait.period_s": 12, "model.friction": "lugre"}``,
+        in order: a later one of the same name wins), checked by the engine together as
+        :meth:`set` checks one, and returns the scenario; unchanged on an error."""
+        return self._update({field: copy.deepcopy(value) for field, value in fields.items()})
 
     def rename(self, name: str, description: str) -> Scenario:
         """Gives the scenario a name and a description of its own, so that an edited scenario

@@ -14,7 +14,7 @@ prefix that name (``u_q_v[2]``, ``i_q_v[2]``, ``E_el_q_v[2]``).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Mapping, Protocol
+from typing import Any, Mapping, Protocol, Sequence
 
 from hexadyn import _core
 
@@ -30,6 +30,7 @@ __all__ = [
     "actuator",
     "actuator_column",
     "leg_column",
+    "phase_codes",
 ]
 
 #: The legs, 0..5.
@@ -39,6 +40,19 @@ PHASE_CODES: dict[str, int] = dict(_core.PHASE_CODES)
 SUPPORT, TAKEOFF, SWING, LANDING = (PHASE_CODES[name] for name in ("support", "takeoff", "swing", "landing"))
 #: Code of a failed leg, held up by the free gait on five legs (beyond the thesis).
 FAILED = PHASE_CODES["failed"]
+
+
+def phase_codes(values: Any, columns: Sequence[str], t: Any) -> Any:
+    """The ``phase[l]`` columns' `values` (rows at the times `t`, one column each of `columns`)
+    as integer codes; ValueError naming the column, the time and the value that is no code of
+    :data:`PHASE_CODES` (a damaged time series)."""
+    import numpy as np
+
+    known = np.isin(values, list(PHASE_CODES.values()))
+    if not known.all():
+        row, column = np.argwhere(~known)[0]
+        raise ValueError(f"column `{columns[column]}` = {float(values[row, column]):g} at t = {float(t[row]):g} s: not a foot phase; allowed: the codes {sorted(PHASE_CODES.values())} ({', '.join(PHASE_CODES)})")
+    return values.astype(np.int8)
 
 
 def leg_column(quantity: str, leg: int) -> str:

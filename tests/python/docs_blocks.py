@@ -16,6 +16,7 @@ markers, invisible on GitHub and on the site:
 from __future__ import annotations
 
 import re
+import shlex
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -63,6 +64,20 @@ class Block:
                     raise ValueError(f"{self.where}: given marker {value!r}: allowed: NAME from PATH")
                 out.append((name.strip(), path.strip()))
         return out
+
+
+def hexadyn_commands(block: Block) -> list[list[str]]:
+    """The arguments of the ``hexadyn`` command lines of an ``sh`` block (comments dropped,
+    ``\\`` continuations joined); ValueError for a line of another command (a block that runs
+    holds hexadyn commands only)."""
+    out = []
+    for line in block.body.replace("\\\n", " ").splitlines():
+        args = shlex.split(line, comments=True)
+        if args:
+            if args[0] != "hexadyn":
+                raise ValueError(f"{block.where}: {line!r}: a runnable sh block holds hexadyn commands only (mark the block no-run, with the reason)")
+            out.append(args[1:])
+    return out
 
 
 def blocks(page: str) -> list[Block]:

@@ -12,14 +12,14 @@ import click
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-from conftest import shortened
+from conftest import assert_one_line_error, shortened
 
 import hexadyn
-from hexadyn import _core
+from hexadyn import _core, health
 from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign
 from hexadyn.montecarlo.storage import RunKey
-from hexadyn.options import COMMON, CommonOption, parse_set
+from hexadyn.options import COMMON, UNHEALTHY, CommonOption, parse_set
 
 ROOT = Path(__file__).resolve().parents[2]
 CLI_DOC = ROOT / "docs" / "cli.md"
@@ -181,6 +181,39 @@ def test_compare_friction_sets_the_fields_on_every_run(tmp_path):
     robot = pd.read_csv(out / "robot_power.csv").set_index("model")
     assert robot["duration_s"].to_dict() == {"none": pytest.approx(0.3), "lugre": pytest.approx(0.3)}
     assert not (out / "plots").exists()
+
+
+def test_robot_run_sets_the_fields_of_its_scenario(tmp_path):
+    out = tmp_path / "robot"
+    result = invoke("robot", "run", "stand_six_legs", "--link", "loopback", "--emulated", "--set", "scenario.duration_s=0.2", "--out", str(out), "--no-progress", "--no-plots")
+    assert result.exit_code == 0, result.output
+    results = hexadyn.Results.load(out)
+    assert results.timeseries.index[-1] == pytest.approx(0.2) and results.summary["duration_s"] == pytest.approx(0.2)
+    assert "[derived: scenario.duration_s = 0.2]" in results.metadata["scenario"]
+    assert _core.load_scenario(str(hexadyn.SCENARIOS_DIR / "stand_six_legs.toml"))["duration_s"] != 0.2
+
+
+@pytest.mark.parametrize("command", ["run", "emulate"])
+def test_the_robot_commands_refuse_a_bad_set_field_in_one_line(command, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = invoke("robot", command, "stand_six_legs", "--link", "loopback", "--set", "model.frction=1")
+    assert_one_line_error(result, "field `model.frction` = 1: unknown field")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_compare_friction_checks_every_run_and_strict_exits_3(tmp_path, monkeypatch):
+    walk = shortened("validation_tripod_1_5cm", tmp_path, 0.3)
+    args = ["compare-friction", str(walk), "--velocities", "1.5", "--models", "none", "--workers", "1", "--no-progress", "--no-plots"]
+    healthy = invoke(*args, "--strict", "--out", str(tmp_path / "healthy"))
+    assert healthy.exit_code == 0 and "WARNING" not in healthy.stderr, healthy.output
+    assert pd.read_csv(tmp_path / "healthy" / "robot_power.csv")["warnings"].isna().all()
+    monkeypatch.setattr(health, "MAX_PENETRATION_RATIO", 0.0)  # every foot "too deep" (the workers are forked)
+    for strict, status in [([], 0), (["--strict"], UNHEALTHY)]:
+        out = tmp_path / f"unhealthy{len(strict)}"
+        result = invoke(*args, *strict, "--out", str(out))
+        assert result.exit_code == status, result.output
+        assert re.fullmatch(r"WARNING: friction model none, V_x = 0.015 m/s: a foot went [^\n]* into the ground[^\n]*\n", result.stderr), result.stderr
+        assert "into the ground" in pd.read_csv(out / "robot_power.csv").set_index("model").loc["none", "warnings"]
 
 
 def test_a_campaign_sets_its_fields_on_every_run_and_stores_them(tmp_path):

@@ -15,7 +15,7 @@ from hexadyn.cli import cli
 
 from conftest import assert_drawn, shortened
 
-MODELS = ["none", "dry_viscous", "lugre", "dry_viscous_load"]
+MODELS = ["none", "dry_viscous", "lugre", "dry_viscous_load", "efficiency"]
 
 
 @pytest.fixture(scope="module")
@@ -47,6 +47,8 @@ def test_cli_compare_friction(short_walk: Path, tmp_path: Path):
         assert p[(v, "none")] < 0.3 * p[(v, "dry_viscous")]
         assert p[(v, "lugre")] == pytest.approx(p[(v, "dry_viscous")], rel=0.25)
         assert p[(v, "dry_viscous_load")] > p[(v, "dry_viscous")]
+        # The efficiency law adds a loss to Eq. 6.1 wherever a transmission carries a load.
+        assert p[(v, "efficiency")] > p[(v, "dry_viscous")]
         assert robot.loc[(v, "none"), "friction_share"] == 0 and robot.loc[(v, "none"), "friction_power_share"] == pytest.approx(0, abs=1e-12)
         assert robot.loc[(v, "dry_viscous"), "friction_power_share"] == pytest.approx(1 - p[(v, "none")] / p[(v, "dry_viscous")], rel=1e-6)
     assert (robot.xs(0.02, level="velocity_m_s")["distance_m"] > 1.5 * robot.xs(0.01, level="velocity_m_s")["distance_m"]).all()
@@ -83,7 +85,7 @@ def test_bad_input_is_refused_before_running(short_walk: Path, tmp_path: Path, m
         (["--velocities", "1,10"], "V_x = 0.1 m/s"),
         (["--velocities", "-1"], "allowed: positive velocities"),
         (["--velocities", "1,x"], "comma-separated velocities in cm/s"),
-        (["--models", "lugre,coulomb"], "allowed: none, dry_viscous, lugre, dry_viscous_load"),
+        (["--models", "lugre,coulomb"], "allowed: none, dry_viscous, lugre, dry_viscous_load, efficiency"),
     ]:
         result = runner.invoke(cli, ["compare-friction", str(short_walk), "--no-progress", *args], prog_name="hexadyn")
         assert result.exit_code != 0 and message in result.output and "Traceback" not in result.output, (args, result.output)

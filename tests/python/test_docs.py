@@ -8,7 +8,8 @@
   described in docs_blocks.py; a block that must not run says why (``no-run: REASON``), and
   each page's count of those is held here, so that one more is a decision, not a slip.
 - The site builds with ``mkdocs build --strict`` (any warning, a broken link first, fails).
-- No placeholder is left, and a measured figure carries its date, machine and commit.
+- No placeholder is left, and a measured figure carries its date, machine (cores and CPU
+  model) and commit.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import matplotlib
 import pandas as pd
 import pytest
 from click.testing import CliRunner
-from docs_blocks import LANGUAGES, PAGES, ROOT, Block, blocks, prose
+from docs_blocks import LANGUAGES, PAGES, ROOT, Block, blocks, hexadyn_commands, prose
 
 from hexadyn.cli import cli
 
@@ -43,7 +44,7 @@ NO_RUN = {
     "docs/install.md": 2,  # pip install
     "docs/monte-carlo.md": 1,  # full campaigns, a Ray cluster
     "docs/robot-link.md": 1,  # master and emulator in real time, two terminals
-    "docs/studies.md": 2,  # the shipped study's 6144 walks, from the CLI and from Python
+    "docs/studies.md": 3,  # the shipped studies: 6144 walks, from the CLI and from Python; the efficiency study with its comparison
 }
 
 
@@ -81,7 +82,7 @@ AFTER_PAGE = {"docs/add-your-robot.md": the_walk_through_walks}
 def run_block(block: Block, folder: Path, namespace: dict[str, object]) -> None:
     """Runs one block in `folder` (the current directory); `namespace` is the page's script."""
     if block.language == "sh":
-        for command in commands(block):
+        for command in hexadyn_commands(block):
             run_hexadyn(block, command)
     elif block.language == "python":
         exec(compile(block.body, block.where, "exec"), namespace)
@@ -100,18 +101,6 @@ def run_block(block: Block, folder: Path, namespace: dict[str, object]) -> None:
         assert compiled.returncode == 0, f"{block.where}: does not compile:\n{compiled.stderr}"
     elif block.language == "rust":
         pytest.fail(f"{block.where}: a rust block shows a fragment: mark it no-run with the test that compiles the same calls")
-
-
-def commands(block: Block) -> list[list[str]]:
-    """The command lines of an ``sh`` block (comments dropped, ``\\`` continuations joined)."""
-    text = block.body.replace("\\\n", " ")
-    out = []
-    for line in text.splitlines():
-        args = shlex.split(line, comments=True)
-        if args:
-            assert args[0] == "hexadyn", f"{block.where}: {line!r}: a runnable sh block holds hexadyn commands only (mark the block no-run, with the reason)"
-            out.append(args[1:])
-    return out
 
 
 def run_hexadyn(block: Block, args: list[str]) -> None:
@@ -157,6 +146,9 @@ MEASURED = re.compile(
 DATE = re.compile(r"\b20\d\d-\d\d-\d\d\b")
 COMMIT = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b")
 MACHINE = re.compile(r"\b\d+[- ]cores?\b")
+#: The machine's CPU: its model (`lscpu`'s "Model name"), or, for a figure measured before the
+#: stamps named it, that it was not recorded.
+CPU = re.compile(r"\b(?:AMD EPYC|AMD Ryzen|Intel|Apple M\d|Graviton|Ampere)\b|\bCPU model not recorded\b")
 
 
 def figure_paragraphs(page: str) -> list[tuple[str, str]]:
@@ -179,7 +171,8 @@ def figure_paragraphs(page: str) -> list[tuple[str, str]]:
 def test_measured_figures_carry_their_date_machine_and_commit(page: str) -> None:
     missing = []
     for around, paragraph in figure_paragraphs(page):
-        lacks = [what for what, stamp in (("date", DATE), ("machine (N-core)", MACHINE), ("commit", COMMIT)) if not (stamp.search(paragraph) or stamp.search(around))]
+        stamps = (("date", DATE), ("machine (N-core)", MACHINE), ("CPU model (or 'CPU model not recorded')", CPU), ("commit", COMMIT))
+        lacks = [what for what, stamp in stamps if not (stamp.search(paragraph) or stamp.search(around))]
         if lacks:
             missing.append(f"{', '.join(lacks)}: {paragraph[:100]!r}")
     assert not missing, f"{page}: figures without " + "\n".join(missing)

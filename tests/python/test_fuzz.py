@@ -16,6 +16,8 @@ from hypothesis import strategies as st
 import hexadyn
 from hexadyn import _core, health
 
+from fuzz_edits import BYTE_EDITS, byte_edit
+
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = {p.name: p.read_bytes() for p in hexadyn.scenario_files()}
 ROBOT = (ROOT / "robots" / "amru5.toml").read_bytes()
@@ -45,16 +47,8 @@ def mutated(draw) -> tuple[str, bytes]:
     for _ in range(draw(st.integers(1, 3))):
         kind = draw(st.sampled_from(["flip", "delete_line", "duplicate_line", "replace_value", "extreme_number", "bom", "non_utf8", "truncate"]))
         lines = lines_of(text)
-        if kind == "flip" and text:
-            i = draw(st.integers(0, len(text) - 1))
-            text = text[:i] + bytes([draw(st.integers(0, 255))]) + text[i + 1 :]
-        elif kind == "delete_line":
-            del lines[draw(st.integers(0, len(lines) - 1))]
-            text = b"\n".join(lines)
-        elif kind == "duplicate_line":
-            i = draw(st.integers(0, len(lines) - 1))
-            lines.insert(i, lines[i])
-            text = b"\n".join(lines)
+        if kind in BYTE_EDITS:
+            text = byte_edit(draw, text, kind)
         elif kind in ("replace_value", "extreme_number"):
             assignments = [i for i, line in enumerate(lines) if b"=" in line and not line.lstrip().startswith(b"#")]
             if assignments:
@@ -66,13 +60,9 @@ def mutated(draw) -> tuple[str, bytes]:
                     value = repr(draw(st.floats(allow_nan=True, allow_infinity=True))).encode()  # 'nan', 'inf', '1e+308': TOML floats
                 lines[i] = key + b"= " + value
                 text = b"\n".join(lines)
-        elif kind == "bom":
-            text = b"\xef\xbb\xbf" + text
         elif kind == "non_utf8":
             i = draw(st.integers(0, len(text)))
             text = text[:i] + draw(st.sampled_from([b"\xff", b"\xc3", b"\xe9", b"\x80\x80", b"\x00"])) + text[i:]
-        elif kind == "truncate":
-            text = text[: draw(st.integers(0, len(text)))]
     return name, text
 
 

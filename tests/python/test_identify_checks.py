@@ -176,3 +176,17 @@ def test_a_device_or_a_fifo_as_robot_file_fails_at_once(frame, tmp_path):
     garbage = tmp_path / "robot.toml"
     garbage.write_bytes(b"\xff\xfe not text")
     assert_one_line_error(invoke(str(path), "--robot", str(garbage), "--out", str(tmp_path / "c")), f"{garbage}: not UTF-8 text (invalid byte at offset 0)")
+
+
+def test_a_csv_log_larger_than_the_bound_is_refused_before_reading(tmp_path):
+    """Found by test_fuzz_cli.py: a CSV log was read by pandas whatever its size; a sparse 1 TB
+    file filled the machine's memory until the kernel killed the process. It is refused from
+    its size, in one line naming it and the bound."""
+    from hexadyn.identify.reading import MAX_LOG_BYTES
+
+    log = tmp_path / "huge.csv"
+    with open(log, "wb") as f:
+        f.truncate(2**40)
+    result = CliRunner().invoke(cli, ["identify", str(log), "--out", str(tmp_path / "out")])
+    assert_one_line_error(result, f"{log}: cannot read the CSV file: {log}: {2**40} bytes, too large; allowed: a regular file of at most 1 GB")
+    assert MAX_LOG_BYTES == 2**30 and not (tmp_path / "out").exists()

@@ -324,3 +324,20 @@ def test_any_command_removes_the_partials_of_killed_runs_from_the_results_root(t
     result = run("info", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert [p.name for p in root.iterdir()] == [live.name]
+
+
+def test_the_viewer_names_a_foot_phase_that_is_no_phase_code(saved: Path, tmp_path: Path):
+    """Found by test_fuzz_cli.py: `hexadyn view --html` of a time series whose foot phase was
+    made NaN wrote its page with numpy's cast warning on stderr. It is refused in one line
+    naming the file, the column and the time."""
+    pytest.importorskip("viser")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder = copy_of(saved, tmp_path)
+    table = pq.read_table(folder / "timeseries.parquet")
+    table = table.set_column(table.column_names.index("phase[1]"), "phase[1]", pa.array([np.nan] * table.num_rows))
+    pq.write_table(table, folder / "timeseries.parquet")
+    result = run("view", str(folder), "--html", str(tmp_path / "v.html"))
+    refused(result, f"{folder / 'timeseries.parquet'}: column `phase[1]` = nan at t = 0 s: not a foot phase; allowed: the codes")
+    assert not (tmp_path / "v.html").exists()

@@ -6,6 +6,7 @@ one set."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import sqlite3
@@ -18,7 +19,7 @@ from click.testing import CliRunner
 from conftest import assert_one_line_error, shortened
 from scipy import stats
 
-from hexadyn import atomic
+from hexadyn import atomic, health
 from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign, FrictionDistributions, draw_friction
 from hexadyn.montecarlo import execution
@@ -27,6 +28,7 @@ from hexadyn.montecarlo.execution import ProcessPool, Ray
 from hexadyn.montecarlo.sampling import MIN_ACCEPTANCE
 from hexadyn.montecarlo.storage import DATABASE_FILE
 from hexadyn.montecarlo.tables import FIGURE_FILES, TABLE_FILE
+from hexadyn.options import UNHEALTHY
 
 FIELD = "model.joint_friction.q_v.tau_f_d_plus"  # physical values >= 0
 
@@ -250,3 +252,50 @@ def test_a_failed_pdf_leaves_the_previous_set_and_no_partial(finished, tmp_path,
         write_results(table, out)
     assert {name: (out / name).read_bytes() for name in before} == before
     assert not [p.name for p in out.iterdir() if p.name.startswith(".")]
+
+
+# ---------------------------------------------------------------------------------------------
+# Health checks of the runs: kept in runs.sqlite, one WARNING line, --strict
+# ---------------------------------------------------------------------------------------------
+
+
+def test_the_runs_health_checks_are_kept_and_strict_exits_3(scenario, tmp_path, monkeypatch):
+    monkeypatch.setattr(health, "MAX_PENETRATION_RATIO", 0.0)  # every foot "too deep" (the workers are forked)
+    out = tmp_path / "mc"
+    args = [str(scenario), "--out", str(out), "--runs", "2", "--velocities", "1", "--variants", "dry_viscous", "--workers", "2", "--no-progress"]
+    result = invoke(*args, "--strict")
+    assert result.exit_code == UNHEALTHY, result.output
+    assert "Specific resistance xi" in result.stdout
+    line = result.stderr
+    assert line.startswith("WARNING: 2 of 2 simulations failed a health check: dry_viscous at V_x = 0.01 m/s (2: run 0, 1); the first (dry_viscous, V_x = 0.01 m/s, run 0): a foot went ")
+    assert line.endswith(f"three feet: check model.k_gnd and the integrator settings (column warnings of {out / DATABASE_FILE})\n") and line.count("\n") == 1, line
+    with sqlite3.connect(out / DATABASE_FILE) as db:
+        stored = [json.loads(w) for (w,) in db.execute("SELECT warnings FROM runs")]
+    assert len(stored) == 2 and all(len(w) == 1 and "into the ground" in w[0] for w in stored)
+    # Resumed without --strict: nothing is rerun, the same line from the store, status 0.
+    again = invoke(*args)
+    assert again.exit_code == 0 and again.stderr == line, again.output
+
+
+def test_a_healthy_campaign_passes_strict(finished, scenario, tmp_path):
+    out = tmp_path / "mc"
+    shutil.copytree(finished, out)
+    result = invoke(str(scenario), "--out", str(out), "--runs", "2", "--velocities", "1", "--variants", "dry_viscous", "--no-progress", "--strict")
+    assert result.exit_code == 0 and result.stderr == "", result.output
+    with sqlite3.connect(out / DATABASE_FILE) as db:
+        assert [json.loads(w) for (w,) in db.execute("SELECT warnings FROM runs")] == [[], []]
+
+
+def test_a_campaign_stored_without_the_warnings_column_resumes(finished, scenario, tmp_path):
+    """A runs.sqlite of a hexadyn that did not record the health checks, its second run not
+    finished: the column is added, the stored run holds NULL (not checked), the campaign
+    resumes with the run left and records its checks."""
+    out = tmp_path / "mc"
+    shutil.copytree(finished, out)
+    with sqlite3.connect(out / DATABASE_FILE) as db:
+        db.execute("ALTER TABLE runs DROP COLUMN warnings")
+        db.execute("DELETE FROM runs WHERE run_index = 1")
+    result = invoke(str(scenario), "--out", str(out), "--runs", "2", "--velocities", "1", "--variants", "dry_viscous", "--workers", "1", "--no-progress", "--strict")
+    assert result.exit_code == 0 and result.stderr == "", result.output
+    with sqlite3.connect(out / DATABASE_FILE) as db:
+        assert list(db.execute("SELECT run_index, warnings FROM runs ORDER BY run_index")) == [(0, None), (1, "[]")]

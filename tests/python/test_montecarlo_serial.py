@@ -239,7 +239,7 @@ def test_bad_overrides_are_one_line(walk_file, overrides, field, allowed):
 
 
 def test_a_load_variant_is_refused_on_serial_legs(scenario):
-    with pytest.raises(ValueError, match=r"variants = \['dry_viscous_load'\]: need distinct variants among dry_viscous \(no load influence"):
+    with pytest.raises(ValueError, match=r"variants = \['dry_viscous_load'\]: need distinct variants among dry_viscous, efficiency \(no load influence"):
         Campaign.create(scenario, variants=["dry_viscous_load"])
 
 

@@ -146,3 +146,20 @@ def test_free_gait_stability_figure(tmp_path: Path):
     assert f"smallest {r.summary['min_stability_margin_m'] * 1e3:.1f} mm" in figures["stability"]._suptitle.get_text()
     assert 0.0 < r.summary["min_stability_margin_m"] == margin.min()
     assert_drawn(tmp_path / "plots" / "stability.png", [plots.SIMULATED], width_in=6.3)
+
+
+def test_plot_draws_a_robot_run_without_its_trajectory(tmp_path: Path, monkeypatch):
+    """Found by test_fuzz_cli.py: `hexadyn plot` on a `hexadyn robot run` folder ended in a
+    KeyError traceback (the trajectory figure asked for the feet, which the master does not
+    measure). It draws the figures the master's record supports, as `robot run` does."""
+    monkeypatch.setattr(Figure, "savefig", lambda self, fname, *a, **k: Path(fname).write_bytes(b""))  # the figures built, not rendered
+    out = tmp_path / "run"
+    runner = CliRunner()
+    result = runner.invoke(cli, ["robot", "run", str(shortened("validation_tripod_1_5cm", tmp_path, 0.1)), "--link", "loopback", "--emulated", "--no-plots", "--no-progress", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(cli, ["plot", str(out), "--no-progress"])
+    assert result.exit_code == 0, (result.output, result.exception)
+    drawn = {p.stem for p in (out / "plots").iterdir()}
+    assert {"gait_diagram", "averaged_power", "energy_breakdown", "leg0_q_r"} <= drawn and "trajectory" not in drawn, drawn
+    with pytest.raises(ValueError, match="no navigation system"):
+        plots.trajectory_figure(Results.load(out))

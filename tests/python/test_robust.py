@@ -5,6 +5,7 @@ ranges and unhealthy runs are reported, and broken inputs give one line naming t
 from __future__ import annotations
 
 import json
+import math
 import os
 import random
 import re
@@ -12,6 +13,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +24,8 @@ from click.testing import CliRunner
 
 import hexadyn
 from hexadyn import _core, atomic, compare, health, report, runner
-from hexadyn.cli import INTERRUPTED, UNHEALTHY, cli
+from hexadyn.cli import INTERRUPTED, cli
+from hexadyn.options import UNHEALTHY
 
 from conftest import shortened, sigint_as_in_a_terminal
 
@@ -260,17 +263,19 @@ def test_health_checks_flag_meaningless_runs():
 
 
 def test_health_sees_a_five_legged_walk_halted_for_good():
-    """Issue 37: with leg 4 failed the shipped five-legged walk halts for good at about 30 s
-    (a deadlock the five-leg rules do not clear); its warnings said nothing. Now the longest
-    deadlock, its start and that it was still on at the end are in the summary, and warned."""
-    r = hexadyn.simulate("free_gait_five_legs", progress=False, overrides={"gait.free.failed_leg": 4})
+    """Issue 37: with leg 4 failed the shipped five-legged walk halted for good at about 30 s
+    (a deadlock the five-leg rules did not clear); its warnings said nothing. Now the longest
+    deadlock, its start and that it was still on at the end are in the summary, and warned. The
+    five-leg footholds clear that deadlock now; a stability margin of 30 cm, which no lift on
+    five legs keeps, halts the walk for good instead."""
+    r = hexadyn.simulate("free_gait_five_legs", progress=False, overrides={"gait.free.failed_leg": 4, "gait.free.stability_margin_m": 0.3})
     s = r.summary
     assert s["deadlocked_at_end"] is True and s["longest_deadlock_s"] > 100.0
     assert s["longest_deadlock_t_s"] + s["longest_deadlock_s"] == pytest.approx(s["duration_s"], abs=0.02)
     deadlock = r.timeseries["deadlock"].to_numpy()
     assert deadlock[-1] == 1.0 and deadlock[r.timeseries.index.get_indexer([s["longest_deadlock_t_s"]], method="nearest")[0]] == 1.0
     assert any(w.startswith(f"the free gait was deadlocked for {s['longest_deadlock_s']:.2f} s") for w in s["warnings"]), s["warnings"]
-    # 200 s at 0.5 cm/s commanded; the body's net advance is about 0.14 m (issue 37).
+    # 200 s at 0.5 cm/s commanded; the body's net advance is about 0.15 m (the sway of the deadlock).
     assert s["commanded_path_length_m"] == pytest.approx(1.0, rel=1e-3) and s["net_displacement_m"] < 0.3
     assert any("m commanded path" in w for w in s["warnings"]), s["warnings"]
     # The shipped walk (leg 5 failed) is healthy.
@@ -456,3 +461,133 @@ def test_every_shipped_scenario_passes_strict(name: str, tmp_path: Path):
     result = invoke("simulate", name, *cut, "--strict", "--no-plots", "--no-progress", "--out", str(tmp_path / "run"))
     assert result.exit_code == 0, result.output
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["warnings"] == []
+
+
+def copy_of_results(saved: Path, broken: Path) -> Path:
+    """A copy of the files of the results folder `saved` in the new folder `broken`, to break."""
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    return broken
+
+
+@pytest.mark.parametrize("command", ["plot", "identify", "export"])
+def test_a_time_series_holding_a_column_twice_is_named_in_one_line(saved: Path, tmp_path: Path, command: str):
+    """Found by test_fuzz_cli.py: a time series with a column renamed to the name of another
+    made that column a table, and `hexadyn identify` ended in an AttributeError traceback."""
+    import pyarrow.parquet as pq
+
+    broken = copy_of_results(saved, tmp_path / "broken")
+    table = pq.read_table(saved / "timeseries.parquet")
+    pq.write_table(table.rename_columns([table.column_names[0] if i == 1 else c for i, c in enumerate(table.column_names)]), broken / "timeseries.parquet")
+    args = {"plot": ["plot", str(broken)], "identify": ["identify", str(broken), "--out", str(tmp_path / "ident")], "export": ["export", str(broken), "--format", "csv"]}[command]
+    result = invoke(*args)
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {'' if command != 'identify' else f'{broken}: cannot read the results folder: '}{broken / 'timeseries.parquet'}: column `{table.column_names[0]}` appears 2 times; allowed: a time series of distinct columns"], result.stderr
+
+
+@pytest.mark.parametrize("edit, words", [("single", "the time series has a single instant"), ("constant", "the time series' instants do not increase (median step 0 s)")])
+def test_plot_refuses_a_time_axis_it_cannot_draw_on_in_one_line(saved: Path, tmp_path: Path, edit: str, words: str):
+    """Found by test_fuzz_cli.py: `hexadyn plot` of a time series cut to one instant, or whose
+    times were all made equal, drew its figures with matplotlib's warning of a singular axis on
+    stderr. The figures are refused first, in one line naming the folder."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    broken = copy_of_results(saved, tmp_path / "broken")
+    table = pq.read_table(saved / "timeseries.parquet")
+    if edit == "single":
+        table = table.slice(0, 1)
+    else:
+        t = table.column_names.index("t")
+        table = table.set_column(t, "t", pa.array([1.0] * table.num_rows))
+    pq.write_table(table, broken / "timeseries.parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and result.stderr.startswith(f"Error: {broken}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
+    assert not (broken / "plots").exists()
+
+
+@pytest.mark.parametrize("edit, words", [("drop", "the time series has no column 'q_r[0]'"), ("phase", "column `phase[3]` = nan at t = 0 s: not a foot phase; allowed: the codes")])
+def test_plot_names_a_missing_column_or_a_phase_that_is_no_phase(tmp_path: Path, edit: str, words: str):
+    """Found by test_fuzz_cli.py: `hexadyn plot` of a time series without a joint's column ended
+    in a KeyError traceback; with a foot phase made NaN it drew figures with numpy's cast
+    warnings on stderr. Both are refused in one line naming the folder and the column (the
+    column dropped from the metadata too: else the folder is refused when loaded, below)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder = tmp_path / "walk"
+    hexadyn.simulate(shortened("validation_tripod_1_5cm", tmp_path, 0.05), folder, progress=False)
+    table = pq.read_table(folder / "timeseries.parquet")
+    if edit == "drop":
+        table = table.drop_columns(["q_r[0]"])
+        metadata = json.loads((folder / "metadata.json").read_text())
+        del metadata["units"]["q_r[0]"]
+        (folder / "metadata.json").write_text(json.dumps(metadata))
+    else:
+        table = table.set_column(table.column_names.index("phase[3]"), "phase[3]", pa.array([math.nan] * table.num_rows))
+    pq.write_table(table, folder / "timeseries.parquet")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = invoke("plot", str(folder))
+    assert result.exit_code == 1 and result.stderr.startswith(f"Error: {folder}: {words}") and len(result.stderr.splitlines()) == 1, (result.output, result.exception)
+
+
+@pytest.mark.parametrize("command", [["export", "--format", "mcap"], ["export", "--format", "csv"], ["plot"], ["ground-detection"]])
+def test_a_time_series_without_a_column_its_metadata_lists_is_refused_when_loaded(saved: Path, tmp_path: Path, command: list[str]):
+    """Found by test_fuzz_cli.py: `hexadyn export --format mcap` of a time series that lost a
+    motor current its metadata lists ended in a KeyError traceback. The folder is refused when
+    loaded, naming the file and the column."""
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    pq.write_table(pq.read_table(saved / "timeseries.parquet").drop_columns(["i_q_r[4]", "u_q_r[4]"]), broken / "timeseries.parquet")
+    result = invoke(command[0], str(broken), *command[1:])
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: no column `u_q_r[4]` (and 1 more), which metadata.json lists; allowed: a time series of the columns of its metadata"]
+
+
+def test_an_infinite_duration_is_refused_naming_the_field(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = inf` passed the check of at least one control
+    period, and `hexadyn simulate` ended in an OverflowError traceback (the rows of an infinite
+    run)."""
+    path = tmp_path / "forever.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="inf"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress")
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert result.stderr.splitlines() == [f"Error: {path}:10: field `scenario.duration_s` = inf: not a finite number; allowed: a finite duration >= 0.01 s (one control period)"], result.stderr
+
+
+def test_a_duration_too_long_for_an_integer_count_is_refused_as_too_large(tmp_path: Path):
+    """Found by test_fuzz_cli.py: `duration_s = 1e308` made the count of instants infinite:
+    an OverflowError traceback before the check of the memory a series takes."""
+    path = tmp_path / "long.toml"
+    path.write_text(scenario_text("stand_six_legs", duration_s="1e308"))
+    result = invoke("simulate", str(path), "--no-plots", "--no-progress", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1 and "Traceback" not in result.output, (result.output, result.exception)
+    assert len(result.stderr.splitlines()) == 1 and "Error: the time series would take about inf TB (inf instants x" in result.stderr, result.stderr
+
+
+def test_a_time_series_column_of_text_is_named_in_one_line(saved: Path, tmp_path: Path):
+    """Found by test_fuzz_cli.py: a time series column of strings reached the figures' sums:
+    a numpy casting traceback from `hexadyn plot`."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    for p in saved.iterdir():
+        if p.is_file():
+            (broken / p.name).write_bytes(p.read_bytes())
+    table = pq.read_table(saved / "timeseries.parquet")
+    table = table.set_column(table.column_names.index("q_v[2]"), "q_v[2]", pa.array(["x"] * table.num_rows))
+    pq.write_table(table, broken / "timeseries.parquet")
+    result = invoke("plot", str(broken))
+    assert result.exit_code == 1 and result.stderr.splitlines() == [f"Error: {broken / 'timeseries.parquet'}: column `q_v[2]` holds string values; allowed: a time series of numbers"], (result.output, result.exception)

@@ -71,6 +71,17 @@ def test_set_is_validated_as_overrides_are():
     assert _core.load_scenario(str(s.path), s.overrides())["gait"]["period_s"] == 14.0
 
 
+def test_update_sets_several_fields_at_once_or_none():
+    s = Scenario.load("path_spline")
+    with pytest.raises(ValueError, match="`model.friction` = \"coulomb\""):
+        s.update({"gait.period_s": 14.0, "model.friction": "coulomb"})
+    assert s.fields == {}, "a refused field leaves the scenario as it was, the valid ones too"
+    assert s.update({"gait.period_s": 14.0, "model.friction": "lugre"}) is s
+    assert s.fields == {"gait.period_s": 14.0, "model.friction": "lugre"}
+    info = _core.load_scenario(str(s.path), s.overrides())
+    assert info["gait"]["period_s"] == 14.0 and "lugre" in info["text"]
+
+
 def test_an_edited_scenario_says_it_is_derived_until_renamed():
     s = Scenario.load("validation_tripod_1_5cm")
     original = s.description

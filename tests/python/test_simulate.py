@@ -351,3 +351,27 @@ def test_summary_only_runs_match_full_runs(sine_file: Path):
     for key, value in full["summary"].items():
         if key != "wall_time_s":
             assert lean["summary"][key] == value, key
+
+
+def test_foothold_offset_moves_every_foothold_radially():
+    """`gait.foothold_offset_m` (the spread of the feet, a design parameter of the studies):
+    0 is the thesis' walk bit for bit; +-2 cm moves the mean foot reference of every leg 2 cm
+    away from (towards) the body centre, and changes the energy; beyond the workspace radius it
+    is refused in one line naming the field and the largest offset."""
+    summary = {}
+    spread = {}
+    for offset in (None, 0.0, 0.02, -0.02):
+        overrides = {} if offset is None else {"gait.foothold_offset_m": offset}
+        r = hexadyn.simulate("validation_tripod_1_5cm", progress=False, overrides=overrides)
+        summary[offset] = r.summary
+        s = r.timeseries
+        spread[offset] = np.array([math.hypot(s[f"foot_ref_x[{leg}]"].mean(), s[f"foot_ref_y[{leg}]"].mean()) for leg in range(6)])
+    same = lambda s: {k: v for k, v in s.items() if k != "wall_time_s"}  # noqa: E731
+    assert same(summary[0.0]) == same(summary[None])
+    for offset in (0.02, -0.02):
+        assert np.abs(spread[offset] - spread[None] - offset).max() < 1e-3, spread[offset] - spread[None]
+        assert summary[offset]["clamped_ik_references"] == 0
+    assert summary[-0.02]["energy_electrical_j"] > summary[None]["energy_electrical_j"] > summary[0.02]["energy_electrical_j"]
+    with pytest.raises(ValueError, match=r"field `gait.foothold_offset_m` = 0.5: .*allowed: a finite offset \(m\) of magnitude below 0.14") as error:
+        _core.load_scenario(str(hexadyn.resolve_scenario("validation_tripod_1_5cm")), {"gait.foothold_offset_m": 0.5})
+    assert "\n" not in str(error.value)

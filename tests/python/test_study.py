@@ -5,8 +5,10 @@ validated with one-line errors."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import re
 import signal
 import sqlite3
 import subprocess
@@ -21,10 +23,12 @@ from click.testing import CliRunner
 from conftest import assert_one_line_error, sigint_as_in_a_terminal
 
 import hexadyn
+from hexadyn import health
 from hexadyn.cli import cli
 from hexadyn.montecarlo import Campaign, FrictionDistributions, study_tables
 from hexadyn.montecarlo.execution import SERIES_FIGURES, simulate_run
 from hexadyn.montecarlo.storage import DATABASE_FILE
+from hexadyn.options import UNHEALTHY
 from hexadyn.study import Study, parse_study, read_study
 from hexadyn.study.spec import run_count
 from hexadyn.study.study import RUNS_FILE, STUDY_FILE
@@ -225,33 +229,54 @@ def test_failed_runs_are_stored_and_named(walk_study, tmp_path):
     assert list(runs["status"]) == ["ok"] * 4 + ["failed"] * 2
 
 
+def test_unhealthy_runs_are_named_and_strict_exits_3(walk_study, tmp_path, monkeypatch):
+    """Every run's health checks (`hexadyn.health.check`, as `hexadyn simulate`'s) are kept in
+    the runs' warnings column; the runs that failed one are named on one WARNING line, and
+    --strict makes them exit status 3."""
+    args = ["study", str(walk_study), "--workers", "1", "--no-progress", "--no-plots"]
+    healthy = CliRunner().invoke(cli, [*args, "--strict", "--out", str(tmp_path / "healthy")])
+    assert healthy.exit_code == 0 and "WARNING" not in healthy.stderr, healthy.output
+    assert (pd.read_csv(tmp_path / "healthy" / RUNS_FILE)["warnings"] == "[]").all()
+    monkeypatch.setattr(health, "MAX_PENETRATION_RATIO", 0.0)  # every foot "too deep" (the workers are forked)
+    for strict, status in [([], 0), (["--strict"], UNHEALTHY)]:
+        out = tmp_path / f"unhealthy{len(strict)}"
+        result = CliRunner().invoke(cli, [*args, *strict, "--out", str(out)])
+        assert result.exit_code == status, result.output
+        pattern = r"WARNING: 4 of 4 runs failed a health check \(run 0, 1, 2, 3\); the first \(run 0\): a foot went [^\n]* into the ground[^\n]* \(column warnings of [^\n]*runs.csv\)\n"
+        assert re.fullmatch(pattern, result.stderr), result.stderr
+        warnings = [json.loads(w) for w in pd.read_csv(out / RUNS_FILE)["warnings"]]
+        assert all(len(w) == 1 and "into the ground" in w[0] for w in warnings)
+
+
 WALK_PARAMETERS = ["gait.period_s", "gait.overlap", "gait.clearance_m", "gait.body_height_m"]
+#: The AMRU5 study's walk parameters: the PhantomX's and the spread of the footholds.
+AMRU5_WALK = WALK_PARAMETERS + ["gait.foothold_offset_m"]
 
 
 @pytest.mark.parametrize(
-    "file, robot, samples, lower, upper",
+    "file, robot, samples, walk, lower, upper",
     [
-        ("specific_resistance_1_5cm.toml", "amru5", 512, [8.0, 0.02, 0.04, 0.40], [16.0, 0.10, 0.10, 0.48]),
-        ("phantomx_gait.toml", "phantomx", 256, [0.6, 0.02, 0.02, 0.09], [1.6, 0.10, 0.045, 0.14]),
+        ("specific_resistance_1_5cm.toml", "amru5", 512, AMRU5_WALK, [8.0, 0.02, 0.04, 0.40, -0.03], [16.0, 0.10, 0.10, 0.48, 0.03]),
+        ("phantomx_gait.toml", "phantomx", 256, WALK_PARAMETERS, [0.6, 0.02, 0.02, 0.09], [1.6, 0.10, 0.045, 0.14]),
     ],
 )
-def test_shipped_study_is_valid(file, robot, samples, lower, upper):
+def test_shipped_study_is_valid(file, robot, samples, walk, lower, upper):
     """Its fields and outputs pass the engine (Study.create's run at the nominal values), its
     runs stay within the walk's ranges docs/studies.md states, and its friction is the robot's
     Monte Carlo campaign's (the [monte_carlo] table of its description, ``study_tables``)."""
     spec = read_study(STUDIES / file)
     tables = study_tables(FrictionDistributions.of_robot(robot))
-    dimension = len(WALK_PARAMETERS) + len(tables["parameters"])
+    dimension = len(walk) + len(tables["parameters"])
     assert spec.design.method == "sobol" and spec.design.samples == samples and run_count(spec) == samples * (dimension + 2)
-    assert [p.key for p in spec.parameters] == WALK_PARAMETERS + list(tables["parameters"])
+    assert [p.key for p in spec.parameters] == walk + list(tables["parameters"])
     assert spec.fixed == tables["fixed"]
-    for p in spec.parameters[len(WALK_PARAMETERS):]:
+    for p in spec.parameters[len(walk):]:
         expected = tables["parameters"][p.key]
         assert p.distribution == expected["distribution"] and (p.mean, p.std) == (expected["mean"], expected["std"])
         np.testing.assert_allclose(p.range, expected["range"], rtol=1e-9, atol=1e-9)
     x = Study.create(spec).samples
     assert x.shape == (samples * (dimension + 2), dimension)
-    assert (x[:, :4].min(axis=0) >= lower).all() and (x[:, :4].max(axis=0) <= upper).all()
+    assert (x[:, : len(walk)].min(axis=0) >= lower).all() and (x[:, : len(walk)].max(axis=0) <= upper).all()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -297,6 +322,25 @@ def test_friction_study_reproduces_the_monte_carlo_campaign(tmp_path):
     assert abs(std_mc - std_study) <= se_std, (std_mc, std_study, se_std)
 
 
+def test_shipped_efficiency_study_sets_the_efficiency_law_beside_the_load_dependence(tmp_path: Path):
+    """docs/studies.md, efficiency against load-dependent friction, on one step (12 s) of its
+    walk: the grid holds the robot's efficiency, the specific resistance falls as the horizontal
+    screws' forward efficiency rises, and at the robot's efficiency it stays below the
+    load-dependent friction's (Section 6.4.4) and above the dry/viscous one's."""
+    spec = read_study(STUDIES / "efficiency_vs_load_dependent.toml")
+    key = "model.joint_friction.q_h.eta_forward"
+    assert spec.design.method == "grid" and [p.key for p in spec.parameters] == [key] and 0.638 in spec.parameters[0].values
+    step = {"scenario.duration_s": 12.0}
+    runs = Study.create(spec, fixed=step).run(tmp_path / "study", workers=1, progress=False, plots=False).runs
+    assert (runs["status"] == "ok").all()
+    xi = runs.set_index(key)["specific_resistance"]
+    assert (np.diff(xi.to_numpy()) < 0).all(), xi
+    walk = "validation_tripod_1_5cm"
+    load = hexadyn.simulate(walk, progress=False, overrides={**step, "model.friction": "dry_viscous", "model.load_dependence": True}).summary["specific_resistance"]
+    dry = hexadyn.simulate(walk, progress=False, overrides={**step, "model.friction": "dry_viscous"}).summary["specific_resistance"]
+    assert dry < xi[0.638] < load, (dry, xi[0.638], load)
+
+
 # ----------------------------------------------------------------------------------------------
 # Validation: one line naming the file, the field, the value and what is allowed
 # ----------------------------------------------------------------------------------------------
@@ -337,3 +381,12 @@ def test_bad_settings_and_missing_files_are_one_line(tmp_path, walk_study):
     assert_one_line_error(result, "--set gait.period_s: the study varies this field")
     result = CliRunner().invoke(cli, ["study", str(walk_study), "--set", "noequals"])
     assert result.exit_code == 2 and "KEY=VALUE" in result.stderr
+
+
+def test_a_fixed_field_of_a_toml_date_is_refused_in_one_line(tmp_path):
+    """Found by test_fuzz_cli.py: a `[fixed]` value TOML reads as a date reached the engine,
+    which has no dates: a TypeError traceback."""
+    study = tmp_path / "study.toml"
+    study.write_text('[study]\nscenario = "stand_six_legs"\noutputs = ["energy_electrical_j"]\n\n[fixed]\n"scenario.duration_s" = 1979-05-27\n\n[design]\nmethod = "grid"\nlevels = 2\n\n[parameters."model.mu"]\nrange = [0.3, 0.6]\n')
+    result = CliRunner().invoke(cli, ["study", str(study), "--no-plots", "--no-progress", "--out", str(tmp_path / "out")])
+    assert_one_line_error(result, f'{study}: field `fixed."scenario.duration_s"` = "1979-05-27": allowed: a value a scenario field holds')

@@ -176,13 +176,19 @@ fn free_gait_keeps_its_posture_on_a_20_degree_slope() {
     assert!(z.iter().cloned().fold(0.0, f64::max) > z[0] + 0.3);
 }
 
-/// Beyond the thesis: five legs, leg `failed` held up (the shipped scenario has leg 3), walk
-/// 200 s at 0.5 cm/s on flat ground with the landings detected from the motor currents: no
-/// fall (the body within 10° of level), every landing detected and none in the air, no deadlock at the end, most of the 1 m
-/// covered; the failed foot never touches the ground.
-fn assert_five_legs_walk(failed: usize) {
-    let s = edited("free_gait_five_legs", |text| text.replacen("failed_leg = 3", &format!("failed_leg = {failed}"), 1));
-    let what = format!("five legs, leg {failed} failed");
+/// Beyond the thesis (issue 37): five legs, leg `failed` held up (the shipped scenario has leg
+/// 3), 200 s at 0.5 cm/s on flat ground, forwards or `backwards`, with the landings detected
+/// from the motor currents: no fall (the body within 10° of level), every landing detected and
+/// none in the air, no deadlock at the end nor longer than the health check allows, never
+/// fewer than three loaded feet for longer than it allows, at least 0.9 m of the commanded
+/// 1 m covered along the command (the net advance), the stability margin of the feet in
+/// support never below zero, no clamped reference; the failed foot never touches the ground.
+fn assert_five_legs_walk(failed: usize, backwards: bool) {
+    let s = edited("free_gait_five_legs", |text| {
+        let text = text.replacen("failed_leg = 3", &format!("failed_leg = {failed}"), 1);
+        if backwards { text.replacen("vx_m_s = 0.005", "vx_m_s = -0.005", 1) } else { text }
+    });
+    let what = format!("five legs, leg {failed} failed, {}", if backwards { "backwards" } else { "forwards" });
     let r = run_scenario(&s, |_| {}).unwrap();
     // The body leans towards the corner without a foot between touchdowns: up to 5.2° with a
     // rear leg failed.
@@ -190,56 +196,114 @@ fn assert_five_legs_walk(failed: usize) {
     let l = landings(&r.series, &what);
     let (longest, stuck) = deadlocks(&r.series);
     let g = r.summary.gait.as_ref().unwrap();
-    println!("free gait on five legs, leg {failed} failed, 200 s at 0.5 cm/s: walked {:.3} m, XY error at the end {:.2} mm, at least {feet} feet down; {}; longest deadlock {longest:.2} s", g.distance_walked_m, 1e3 * g.tracking_error_xy_final_m, l.report());
+    let x = column(&r.series, "X");
+    let advance = (x[x.len() - 1] - x[0]) * if backwards { -1.0 } else { 1.0 };
+    let margin = column(&r.series, "stability_margin").iter().cloned().fold(f64::INFINITY, f64::min);
+    let lost = g.episodes.support_loss.longest.map_or(0.0, |(d, _)| d);
+    println!(
+        "free gait on {what}, 200 s at 0.5 cm/s: net advance {advance:.3} m (path {:.3} m), XY error at the end {:.2} mm, at least {feet} feet down, longest under three {lost:.2} s; {}; longest deadlock {longest:.2} s; smallest stability margin {:.1} mm; {} clamped references",
+        g.distance_walked_m,
+        1e3 * g.tracking_error_xy_final_m,
+        l.report(),
+        1e3 * margin,
+        g.clamped_ik_references
+    );
     assert!(column(&r.series, &format!("Fn[{failed}]")).iter().all(|&f| f == 0.0), "{what}: the failed foot touched the ground");
     assert!(column(&r.series, &format!("phase[{failed}]")).iter().all(|&p| p == 4.0));
-    assert!(!stuck, "{what}: deadlocked at the end");
+    assert!(!stuck && longest < MAX_DEADLOCK_S, "{what}: longest deadlock {longest} s, deadlocked at the end: {stuck}");
+    assert!(lost <= MAX_SUPPORT_LOSS_S, "{what}: fewer than three loaded feet for {lost} s");
     assert!(l.forces.len() + 5 >= l.count && l.count >= 40, "{what}: {}", l.report());
-    assert!(g.distance_walked_m > 0.9, "{what}: walked {} m", g.distance_walked_m);
+    assert!(advance > 0.9, "{what}: advanced {advance} m");
+    assert!(margin >= 0.0, "{what}: stability margin {margin} m");
+    assert_eq!(g.clamped_ik_references, 0, "{what}");
 }
+
+/// The health check's longest deadlock and loss of support in a healthy free gait (s,
+/// python/hexadyn/health.py).
+const MAX_DEADLOCK_S: f64 = 20.0;
+const MAX_SUPPORT_LOSS_S: f64 = 0.2;
 
 #[test]
 fn free_gait_walks_on_five_legs() {
-    assert_five_legs_walk(3);
+    assert_five_legs_walk(3, false);
 }
 
 #[test]
 fn free_gait_walks_on_five_legs_leg_2_failed() {
-    assert_five_legs_walk(2);
+    assert_five_legs_walk(2, false);
 }
 
+// NOT MET on the full dynamic model with a leg failed at an end of the walk (issue 37; all
+// six walk forwards on the ideal plant, `control::gait::free::tests`). Measured with the
+// footholds of `control::gait::free::five_legs` (2026-11-28, 2-core container, 1b96aa7): with the leg
+// failed at the trailing end (4 or 5 forwards, 0 or 1 backwards) the walk no longer halts for
+// good (it did after 0.28 m): 0.961-0.962 m net advance, longest deadlock 4.6 s, 76 landings all
+// detected, but the body rocks onto two feet for 0.77-1.19 s at a time (the two middle legs, or
+// a front and a middle leg, in the air: the triangle left has the diagonal between the other
+// front foot and the rear one 2 cm from the body centre as the controller knows it, and the
+// body, without navigation, drifts 4.5 cm aside and lags 3 cm), 67-68 mm XY error at the end. With
+// the leg failed at the leading end (no band, as before): leg 0 forwards 0.867 m (1.05 m of path
+// length with the sway, which this test checked before), leg 5 backwards 0.868 m
+// (deadlocks up to 7.9 s), leg 1 forwards 0.918 m but 35 landings, leg 4 backwards 0.835 m and
+// 0.60 s on two feet. Tried and worse: one leg in the air at a time (the walks fell behind:
+// 0.17-0.61 m), a 4 cm margin for a support of three feet (still 0.6-0.9 s on two feet), no
+// lift unless the step gains half a stroke (fewer than 40 landings everywhere).
 #[test]
+#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_0_failed() {
-    assert_five_legs_walk(0);
+    assert_five_legs_walk(0, false);
 }
 
-// NOT MET on the full dynamic model with leg 1, 4 or 5 failed (all six walk the whole 1.5 m on
-// the ideal plant, `control::gait::free::tests`). Leg 0 walks since the deadlock of a support
-// leg held back by the stability margin alone sways the body towards the other feet
-// (`FreeGaitController::sway`) and the deadlock fallback lifts only legs at their boundary.
-// Measured with these: leg 1 failed walks 1.03 m without a lasting deadlock but with 35
-// landings (the acceptance asks 40); with leg 4 or 5 failed the walk halts for good after
-// 0.28 m: the remaining rear leg reaches its rear boundary while the middle feet, at their
-// forward footholds, are still ahead of the body centre, and no sway that keeps that rear foot
-// in its workspace brings the centre 2 cm inside the four other feet (the held-up foot no
-// longer touches the ground since it is held at the top of its reach). Likely remedy, not
-// done: footholds of the middle legs set back with a rear leg failed, or an earlier rear step.
 #[test]
 #[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_1_failed() {
-    assert_five_legs_walk(1);
+    assert_five_legs_walk(1, false);
 }
 
 #[test]
 #[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_4_failed() {
-    assert_five_legs_walk(4);
+    assert_five_legs_walk(4, false);
 }
 
 #[test]
 #[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_5_failed() {
-    assert_five_legs_walk(5);
+    assert_five_legs_walk(5, false);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_backwards_on_five_legs_leg_0_failed() {
+    assert_five_legs_walk(0, true);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_backwards_on_five_legs_leg_1_failed() {
+    assert_five_legs_walk(1, true);
+}
+
+#[test]
+fn free_gait_walks_backwards_on_five_legs_leg_2_failed() {
+    assert_five_legs_walk(2, true);
+}
+
+#[test]
+fn free_gait_walks_backwards_on_five_legs_leg_3_failed() {
+    assert_five_legs_walk(3, true);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_backwards_on_five_legs_leg_4_failed() {
+    assert_five_legs_walk(4, true);
+}
+
+#[test]
+#[ignore = "NOT MET: see the comment above"]
+fn free_gait_walks_backwards_on_five_legs_leg_5_failed() {
+    assert_five_legs_walk(5, true);
 }
 
 /// The deadlock periods of a run (Section 7.7.4): the longest one (s) and whether the run ends
@@ -345,3 +409,4 @@ fn free_gait_follows_the_spline_over_rough_ground() {
         }
     }
 }
+

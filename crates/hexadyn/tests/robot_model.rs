@@ -72,6 +72,9 @@ fn analytic_jacobian_matches_finite_differences() {
         (FrictionModel::LuGre, false, false, JointControl::Digital),
         (FrictionModel::LuGre, true, false, pid),
         (FrictionModel::None, false, false, pid),
+        (FrictionModel::Efficiency, false, false, JointControl::Digital),
+        (FrictionModel::Efficiency, true, false, JointControl::Digital),
+        (FrictionModel::Efficiency, false, false, pid),
     ] {
         let mut r = robot(friction, |o| {
             o.inductance = inductance;
@@ -250,6 +253,8 @@ fn input_change_is_the_difference_of_two_residuals() {
         (FrictionModel::LuGre, true, JointControl::Digital, false),
         (FrictionModel::None, false, pid, false),
         (FrictionModel::LuGre, true, pid, true),
+        (FrictionModel::Efficiency, false, JointControl::Digital, false),
+        (FrictionModel::Efficiency, true, JointControl::Digital, true),
     ] {
         let mut r = robot(friction, |o| {
             o.inductance = inductance;

@@ -696,7 +696,14 @@ fn every_shipped_walk_keeps_its_feet_in_the_workspaces() {
                     let g = run.summary.gait.as_ref().expect("gait summary");
                     assert_eq!(g.clamped_ik_references, 0, "{}: {g:?}", s.name);
                     let bound = match &s.robot {
-                        Robot::Pantograph(_) => 1e-6,
+                        Robot::Pantograph(_) => {
+                            // The references start from the encoders' reading of the initial
+                            // posture: a count of q_v or q_h is about 6 counts at the foot
+                            // (z_foot ~ -6 q_v, Eq. B.1); 4 times coarser on the backdrivable
+                            // drives' quarter ratios.
+                            let count = s.model().encoders.iter().enumerate().filter(|(k, _)| k % 3 != 0).map(|(_, e)| e.resolution()).fold(0.0, f64::max);
+                            1e-6f64.max(6.0 * count)
+                        }
                         Robot::Serial(r) => {
                             let count = s.model().encoders.iter().map(|e| e.resolution()).fold(0.0, f64::max);
                             let reach = r.hexapod.legs.iter().map(|l| l.joints[1].origin.translation.norm() + l.joints[2].origin.translation.norm() + l.foot.norm()).fold(0.0, f64::max);
@@ -770,6 +777,30 @@ fn overrides_set_fields_and_joint_friction_for_every_leg() {
     assert_eq!(again.robot.pantograph().unwrap().friction(3, PantographJoint::Horizontal), s.robot.pantograph().unwrap().friction(3, PantographJoint::Horizontal));
 }
 
+/// `friction = "efficiency"` takes the robot's `[friction.efficiency]`, which the scenario's
+/// `[model.joint_friction.<joint>] eta_forward`, `eta_backward` replace; an efficiency outside
+/// (0, 1] and the load dependence of Eq. 5.12 on top of the law are refused, naming the field.
+#[test]
+fn efficiency_friction_is_selected_overridden_and_checked() {
+    let s = overridden(&[Override::new("model.friction", "efficiency"), Override::new("model.joint_friction.q_h.eta_backward", 0.7)]).unwrap();
+    assert_eq!(s.model.friction, FrictionModel::Efficiency);
+    let robot = s.robot.pantograph().unwrap();
+    for leg in 0..6 {
+        let (v, h, r) = (robot.friction(leg, PantographJoint::Vertical), robot.friction(leg, PantographJoint::Horizontal), robot.friction(leg, PantographJoint::Rotation));
+        assert_eq!((v.eta_forward, v.eta_backward), (0.638, 0.453), "robots/amru5.toml [friction.efficiency]");
+        assert_eq!((h.eta_forward, h.eta_backward), (0.638, 0.7));
+        assert_eq!((r.eta_forward, r.eta_backward), (1.0, 1.0));
+        assert_eq!(h.efficiency().no_load, h.dry_viscous(), "the no-load friction is Eq. 6.1 with Table 5.3");
+    }
+    let error = |o: &[Override]| overridden(o).expect_err("must be rejected").to_string();
+    for (field, value) in [("q_v.eta_forward", 0.0), ("q_h.eta_backward", 1.5), ("q_r.eta_forward", -0.2)] {
+        let s = error(&[Override::new(format!("model.joint_friction.{field}"), value)]);
+        assert!(s.contains(&format!("model.joint_friction.{field}")) && s.contains("(0, 1]") && !s.contains('\n'), "{s}");
+    }
+    let s = error(&[Override::new("model.friction", "efficiency"), Override::new("model.load_dependence", true)]);
+    assert!(s.contains("model.load_dependence") && s.contains("friction = \"efficiency\"") && !s.contains('\n'), "{s}");
+}
+
 #[test]
 fn override_errors_name_the_override() {
     let error = |o: Override| overridden(&[o]).expect_err("must be rejected").to_string();
@@ -791,7 +822,7 @@ fn override_errors_name_the_override() {
 }
 
 /// One step of the validation walk (Section 6.3) with each friction model of the comparison of
-/// Section 6.4, integrated to convergence (tolerance 0.01, h_max 1 ms): the energy account closes
+/// Section 6.4 and the efficiency law, integrated to convergence (tolerance 0.01, h_max 1 ms): the energy account closes
 /// within 0.1 % (electrical = Joule + friction + contact + Δ(T + V) + Δ stored; measured at most
 /// 0.014 %, without friction). At the robot's tolerance the balance error is the integration
 /// error of the step sequence, not a property of the account: without friction −0.104 J of
@@ -800,7 +831,7 @@ fn override_errors_name_the_override() {
 /// [`walking_orders_the_friction_models`].
 #[test]
 fn walking_energy_account_closes_when_the_integration_converges() {
-    for (friction, load) in [("none", false), ("dry_viscous", false), ("dry_viscous", true), ("lugre", false)] {
+    for (friction, load) in [("none", false), ("dry_viscous", false), ("dry_viscous", true), ("lugre", false), ("efficiency", false)] {
         let converged = [Override::new("integrator.tolerance", 0.01), Override::new("integrator.h_max_s", 1e-3)];
         let s = validation_step(friction, load, &converged);
         let e = s.energy_electrical_j;

@@ -2,7 +2,8 @@
 //! (`System::surrogate_residual`, `NewmarkOptions::surrogate_iterations`): the surrogate changes
 //! how many evaluations of f a step takes, never what the integrator accepts, since every
 //! accepted iterate passes the Newton test on f itself; and the steps accepted on the surrogate's
-//! own Newton test while a verification by f vouches for it (`NewmarkOptions::unverified_steps`).
+//! own Newton test while a verification by f vouches for it (`NewmarkOptions::unverified_steps`);
+//! and a step where f and the surrogate alternate without converging, taken again on f alone.
 
 use hexadyn::sim::{Layout, Newmark, NewmarkOptions, Order, System};
 
@@ -138,4 +139,24 @@ fn steps_are_accepted_on_the_surrogate_only_while_a_verification_vouches_for_it(
     assert_eq!(with_biased.unverified_steps, 0, "a surrogate whose verifications fail is never trusted");
     assert!(biased_gap < 1e-5, "biased surrogate: trajectory {biased_gap} m from Newton on f alone");
     assert_eq!(with_verification.unverified_steps, 0);
+}
+
+/// A step where the surrogate and f alternate at every step size (the terrain-class benchmark's
+/// 25° slope, seed 9, uphill 41° from the heading: at t = 71.08 s the body leans on three feet,
+/// the kept J_foot no guide to the contact forces; each evaluation of f brings q'' closer to its
+/// root, the surrogate's iterations take it back, and the step was rejected down to h_min, the
+/// run ending on "Newton-Raphson did not converge"): the step is taken again on f alone
+/// (`Newmark`'s fallback until the next control instant) and the walk goes on.
+#[test]
+fn a_step_the_surrogate_cannot_solve_is_taken_on_f_alone() {
+    use hexadyn::physics::terrain::classes::TerrainClass;
+    use hexadyn::scenario::{run_scenario, Override, Scenario};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios/free_gait_straight.toml");
+    let seeded = TerrainClass::Slope { angle: 25f64.to_radians() }.generate(9).unwrap();
+    assert!(seeded.drawn.contains("uphill at 41 deg"), "{}", seeded.drawn);
+    let overrides = [Override::new("scenario.duration_s", 72.0), Override::new("gait.navigation", true), Override::new("gait.heading.vx_m_s", 0.01)];
+    let mut s = Scenario::from_file_with(&path, &overrides).unwrap_or_else(|e| panic!("{e}"));
+    s.terrain = seeded.terrain;
+    let r = run_scenario(&s, |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.summary.duration_s >= 72.0 - 1e-9, "{}", r.summary.duration_s);
 }

@@ -2,7 +2,8 @@
 
 The experiments are shipped scenarios (``identification_q_r``, ``_q_v``, ``_q_h``: the sawtooth
 campaigns of Table 5.2; ``identification_breakaway_plus``/``_minus``: Section 5.3;
-``identification_loaded_q_h``: Section 5.4; on the PhantomX's serial legs the sawtooth campaigns
+``identification_loaded_q_h``: Section 5.4; ``identification_loaded_q_v``: the efficiencies of
+the efficiency-based friction, Chapter 8 prospect; on the PhantomX's serial legs the sawtooth campaigns
 ``phantomx_identification_coxa``, ``_femur``, ``_tibia``). :func:`identify` reads their results
 folders, or CSV logs of a real robot (:mod:`hexadyn.identify.reading`), and fits the friction
 parameters with their confidence intervals; :func:`hexadyn.identify.output.save` writes the tables of Tables

@@ -23,7 +23,7 @@ __all__ = ["identify_command"]
 def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overwrite: bool, robot: Path | None, transient_s: float, format_: tuple[str, ...], no_progress: bool) -> None:
     """Identify joint friction from LOGS: results folders of the identification scenarios
     (identification_q_r, _q_v, _q_h, identification_breakaway_plus/_minus,
-    identification_loaded_q_h; phantomx_identification_coxa, _femur, _tibia) or CSV logs of a
+    identification_loaded_q_h, identification_loaded_q_v; phantomx_identification_coxa, _femur, _tibia) or CSV logs of a
     real robot. Each log is one campaign; several
     campaigns give the mean and standard deviation of Tables 5.3-5.5."""
     from tqdm.auto import tqdm
@@ -50,4 +50,4 @@ def identify_command(logs: tuple[Path, ...], joint: str | None, out: Path, overw
 
         ident = identify(loaded(), joint, SectionOptions(transient_s=transient_s), progress=lambda _: bar.update())
     folder = save(ident, out, overwrite=overwrite, formats=format_)
-    click.echo(f"{len(ident.fits)} dry/viscous fits, {len(ident.breakaways)} breakaways, {len(ident.load_fits)} load fits -> {folder}")
+    click.echo(f"{len(ident.fits)} dry/viscous fits, {len(ident.breakaways)} breakaways, {len(ident.load_fits)} load fits, {len(ident.efficiency_fits)} efficiency fits -> {folder}")

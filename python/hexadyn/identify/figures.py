@@ -16,7 +16,7 @@ from hexadyn.identify.logs import LEGS
 from hexadyn.identify.tables import UNITS
 from hexadyn.plots import style
 
-__all__ = ["friction_figure", "load_figure", "figures", "figure_stem", "FIGURE_NUMBERS"]
+__all__ = ["friction_figure", "load_figure", "efficiency_figure", "figures", "figure_stem", "FIGURE_NUMBERS"]
 
 #: The thesis figure of each AMRU5 joint type.
 FIGURE_NUMBERS = {"q_r": "5_3", "q_v": "5_4", "q_h": "5_5"}
@@ -85,6 +85,34 @@ def load_figure(ident: Identification) -> Figure:
     return fig
 
 
+def efficiency_figure(ident: Identification, joint: str) -> Figure:
+    """The efficiency law of `joint` (:mod:`hexadyn.identify.efficiency`): per section the torque
+    the transmission carries beyond the no-load friction, e = tau_m - N(q'), against what the
+    leg and its load need, tau_n; the lines e = tau_n / eta_f (forward, the motor drives) and
+    e = eta_b tau_n (backward, the load drives) of each leg's fit."""
+    dry_unit = UNITS[ident.kinds[joint]][0]
+    with style():
+        fig = Figure(figsize=(4.5, 3.2))
+        ax = fig.subplots()
+        for f in (f for f in ident.efficiency_fits if f.joint == joint):
+            colour = f"C{f.leg}"
+            pts = [p for p in ident.points if p.joint == joint and p.leg == f.leg]
+            tau_n = np.array([p.motor_torque - p.torque for p in pts])
+            no_load = np.array([(f.tau_f_d_plus.value + f.f_v_plus.value * p.velocity) if p.direction > 0 else (f.tau_f_d_minus.value + f.f_v_minus.value * p.velocity) for p in pts])
+            e = np.array([p.motor_torque for p in pts]) - no_load
+            ax.plot(tau_n, e, linestyle="none", marker="o", markersize=2.5, color=colour, label=f"leg {f.leg}")
+            for eta, forward in ((f.eta_forward, True), (f.eta_backward, False)):
+                branch = tau_n[(tau_n * np.array([p.velocity for p in pts]) > 0) == forward]
+                if eta is not None and len(branch):
+                    x = np.array([branch.min(), branch.max()]) if np.ptp(branch) > 0 else np.array([0.0, branch[0]])
+                    ax.plot(x, x / eta.value if forward else eta.value * x, color=colour, linewidth=0.7, linestyle="-" if forward else "--")
+        ax.set_xlabel(f"needed by the leg and its load, tau_n ({dry_unit})")
+        ax.set_ylabel(f"carried beyond no-load, e ({dry_unit})")
+        ax.set_title(f"Transmission efficiency of {_NAMES.get(joint, joint)} joints (solid: forward, dashed: backward)", fontsize="small")
+        ax.legend(fontsize="x-small")
+    return fig
+
+
 def figures(ident: Identification) -> dict[str, Figure]:
     """Every figure of an identification, by file stem."""
     out = {}
@@ -94,4 +122,6 @@ def figures(ident: Identification) -> dict[str, Figure]:
             out[stem] = friction_figure(ident, joint, load)
     if ident.load_fits:
         out["figure_5_10_q_h_load"] = load_figure(ident)
+    for joint in dict.fromkeys(f.joint for f in ident.efficiency_fits):
+        out[f"figure_efficiency_{joint}"] = efficiency_figure(ident, joint)
     return out

@@ -17,6 +17,7 @@ import numpy as np
 
 from hexadyn.identify.breakaway import Breakaway, BreakawayOptions, breakaway
 from hexadyn.identify.checks import check_friction_sign
+from hexadyn.identify.efficiency import EfficiencyFit, fit_efficiency
 from hexadyn.identify.logs import LEGS, UNITS, IdentifyError, Log
 from hexadyn.identify.sections import SectionOptions
 from hexadyn.identify.steady import DryViscousFit, LoadFit, SectionPoint, fit_dry_viscous, fit_load, section_points
@@ -36,6 +37,8 @@ class Identification:
         fits: one dry/viscous line per (log, joint, leg, direction) and foot load.
         breakaways: one tau_f,s per (log, leg, direction) of the vertical joints.
         load_fits: Eq. 5.12 per (leg, direction) of the horizontal joints, with loaded logs.
+        efficiency_fits: the efficiency law per (joint, leg) whose sawtooth logs have two foot
+            loads or more (:mod:`hexadyn.identify.efficiency`).
         kinds: joint name -> kind (``"revolute"``, ``"prismatic"``: the units) of the logs'
             robot, in the order of a leg's joints.
         leg_mechanism: the logs' robot's ("pantograph" or "serial"): a serial drive has one
@@ -46,6 +49,7 @@ class Identification:
     fits: list[tuple[str, DryViscousFit]] = field(default_factory=list)
     breakaways: list[Breakaway] = field(default_factory=list)
     load_fits: list[LoadFit] = field(default_factory=list)
+    efficiency_fits: list[EfficiencyFit] = field(default_factory=list)
     kinds: dict[str, str] = field(default_factory=dict)
     leg_mechanism: str = "pantograph"
 
@@ -111,6 +115,7 @@ def identify(
         if progress:
             progress(log.source)
     result.load_fits = _load_fits(result, seed)
+    result.efficiency_fits = _efficiency_fits(result, seed)
     return result
 
 
@@ -164,4 +169,16 @@ def _load_fits(result: Identification, seed: int) -> list[LoadFit]:
                 raise IdentifyError(f"q_h[{leg}]: loaded logs ({sorted({f.load_kg for f in loaded})} kg) without an unloaded one: Eq. 5.12 needs a_0, the unloaded dry friction (add the unloaded campaign's log)")
             a_0 = float(np.mean([f.tau_f_d.value for f in unloaded]))
             fits.append(fit_load(a_0, loaded, seed))
+    return fits
+
+
+def _efficiency_fits(result: Identification, seed: int) -> list[EfficiencyFit]:
+    fits = []
+    for joint in result.kinds:
+        for leg in LEGS:
+            points = [p for p in result.points if p.joint == joint and p.leg == leg]
+            if any(p.load_kg > 0 for p in points):
+                fit = fit_efficiency(points, seed)
+                if fit is not None:
+                    fits.append(fit)
     return fits

@@ -23,7 +23,7 @@ import numpy as np
 from hexadyn.identify.fit import Estimate, fit_linear
 from hexadyn.identify.logs import Log
 from hexadyn.identify.sections import SectionOptions, find_sections
-from hexadyn.identify.torques import friction_torque
+from hexadyn.identify.torques import friction_torque, joint_constants
 
 __all__ = ["SectionPoint", "section_points", "DryViscousFit", "fit_dry_viscous", "LoadFit", "fit_load"]
 
@@ -43,6 +43,9 @@ class SectionPoint:
     torque: float
     t_start: float
     t_stop: float
+    #: The mean motor torque n k_t i (Eq. 5.17) over the section's window; ``motor_torque -
+    #: torque`` is what the leg and its load need (the transmitted torque of the efficiency fit).
+    motor_torque: float
 
 
 def section_points(log: Log, joint: str, leg: int, options: SectionOptions) -> list[SectionPoint]:
@@ -51,9 +54,11 @@ def section_points(log: Log, joint: str, leg: int, options: SectionOptions) -> l
     where = f"{log.source}: {joint}[{leg}]"
     sections = find_sections(t, log.position(joint, leg), options, where)
     points = []
+    torque_per_ampere = joint_constants(log, joint, leg)["torque_per_ampere"]
     for s in sections:
         mean = float(np.mean(friction_torque(log, joint, leg, s.window, s.velocity, s.acceleration)))
-        points.append(SectionPoint(log.source, joint, leg, s.direction, log.foot_load_kg[leg], s.velocity, mean, float(t[s.start]), float(t[s.stop - 1])))
+        motor = torque_per_ampere * float(np.mean(log.current(joint, leg)[s.window]))
+        points.append(SectionPoint(log.source, joint, leg, s.direction, log.foot_load_kg[leg], s.velocity, mean, float(t[s.start]), float(t[s.stop - 1]), motor))
     return points
 
 

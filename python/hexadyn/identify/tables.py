@@ -16,7 +16,7 @@ from hexadyn.identify.fit import Estimate
 from hexadyn.identify.identification import Identification
 from hexadyn.identify.logs import LEGS, UNITS
 
-__all__ = ["mean_sigma", "table_5_3", "table_5_4", "table_5_5", "estimates", "markdown"]
+__all__ = ["mean_sigma", "table_5_3", "table_5_4", "table_5_5", "table_efficiency", "estimates", "markdown"]
 
 def mean_sigma(values: list[float]) -> tuple[float, float]:
     """Eq. 5.8 and 5.9: the mean and the (n - 1) standard deviation (NaN for n < 2)."""
@@ -67,6 +67,24 @@ def table_5_5(ident: Identification) -> pd.DataFrame:
     return pd.DataFrame.from_dict(rows, orient="index", columns=columns)
 
 
+def table_efficiency(ident: Identification, joint: str) -> pd.DataFrame:
+    """Rows eta_f, eta_b and the no-load tau_f,d^+-, f_v^+- of the efficiency law of `joint`
+    (:mod:`hexadyn.identify.efficiency`), columns (leg, value/stderr): one fit over the loads
+    per leg."""
+    dry, viscous = UNITS[ident.kinds[joint]]
+    columns = pd.MultiIndex.from_product([[f"leg {leg}" for leg in LEGS], ["value", "stderr"]])
+    names = {"eta_forward": "eta_f", "eta_backward": "eta_b", "tau_f_d_plus": f"N: tau_f,d^+ ({dry})", "f_v_plus": f"N: f_v^+ ({viscous})", "tau_f_d_minus": f"N: tau_f,d^- ({dry})", "f_v_minus": f"N: f_v^- ({viscous})"}
+    rows = {}
+    for attr, name in names.items():
+        row = []
+        for leg in LEGS:
+            fit = next((f for f in ident.efficiency_fits if f.joint == joint and f.leg == leg), None)
+            e: Estimate | None = getattr(fit, attr) if fit else None
+            row += [e.value, e.stderr] if e else [np.nan, np.nan]
+        rows[name] = row
+    return pd.DataFrame.from_dict(rows, orient="index", columns=columns)
+
+
 def estimates(ident: Identification) -> pd.DataFrame:
     """Every estimate, one row each: source log, joint, leg, direction, load, parameter, value,
     standard error, the Jacobian and bootstrap confidence intervals (95 %)."""
@@ -77,6 +95,15 @@ def estimates(ident: Identification) -> pd.DataFrame:
     for f in ident.load_fits:
         for name, e in (("a_2", f.a_2), ("a_1", f.a_1)):
             rows.append(_row("loaded logs", "q_h", f.leg, f.direction, float("nan"), name, e, len(f.loads_kg)))
+    for f in ident.efficiency_fits:
+        loads = "loaded logs " + ", ".join(f"{x:g}" for x in f.loads_kg) + " kg"
+        for name, e in (("tau_f_d", f.tau_f_d_plus), ("f_v", f.f_v_plus)):
+            rows.append(_row(loads, f.joint, f.leg, 1, float("nan"), f"{name} (no load, efficiency law)", e, f.points))
+        for name, e in (("tau_f_d", f.tau_f_d_minus), ("f_v", f.f_v_minus)):
+            rows.append(_row(loads, f.joint, f.leg, -1, float("nan"), f"{name} (no load, efficiency law)", e, f.points))
+        for name, e in (("eta_forward", f.eta_forward), ("eta_backward", f.eta_backward)):
+            if e is not None:
+                rows.append(_row(loads, f.joint, f.leg, 0, float("nan"), name, e, f.points))
     for b in ident.breakaways:
         nan = float("nan")
         rows.append(_row(b.source, b.joint, b.leg, b.direction, b.load_kg, "tau_f_s", Estimate(b.tau_f_s, nan, nan, nan, nan, nan), 0 if b.reason else 1) | {"note": b.reason})
@@ -88,7 +115,7 @@ def _row(source, joint, leg, direction, load, name, e: Estimate, points) -> dict
         "source": source,
         "joint": joint,
         "leg": leg,
-        "direction": "plus" if direction > 0 else "minus",
+        "direction": {1: "plus", -1: "minus"}.get(direction, "both"),
         "load_kg": load,
         "parameter": name,
         "value": e.value,

@@ -1,5 +1,5 @@
-"""The robot link of Section 2.3.2: the master/slave packets (:mod:`hexadyn.link.packets`, a
-mirror of the engine's), and ``hexadyn robot run`` / ``hexadyn robot emulate``
+"""The robot link of Section 2.3.2: the master/slave packets (:mod:`hexadyn.link.packets`, over
+the engine's codec), and ``hexadyn robot run`` / ``hexadyn robot emulate``
 (:mod:`hexadyn.link.cli`), which run a scenario's controller on the robot, or on the slave
 emulator backed by the simulated robot."""
 

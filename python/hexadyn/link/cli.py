@@ -10,7 +10,7 @@ import click
 
 import hexadyn
 from hexadyn.link import resolve_link
-from hexadyn.options import no_plots_option, no_progress_option, out_option, overwrite_option
+from hexadyn.options import no_plots_option, no_progress_option, out_option, overwrite_option, set_option, strict_option, warn_unhealthy
 
 LINK_HELP = "Link configuration file (addresses, period, timing, safety), or 'loopback' for the shipped one on 127.0.0.0/8."
 
@@ -43,7 +43,7 @@ _FAULT_OPTIONS = (
     click.option("--wrong-size", type=click.FloatRange(0, 1), default=0.0, show_default=True, help="Probability that a packet is cut short or lengthened."),
     click.option("--max-consecutive", type=click.IntRange(0), default=None, help="At most this many packets of one slave destroyed in a row (lost, corrupted, resized)."),
     click.option("--silent-slave", callback=_silent_slave, default=None, help="LEG:COMMANDS: that slave stops answering after so many commands."),
-    click.option("--seed", type=int, default=0, show_default=True, help="Seed of the fault draws."),
+    click.option("--seed", type=click.IntRange(0, 2**64 - 1), default=0, show_default=True, help="Seed of the fault draws."),
 )
 
 
@@ -79,14 +79,16 @@ def _stall(ctx: click.Context, param: click.Parameter, value: str | None) -> tup
 @robot.command("run")
 @click.argument("scenario")
 @click.option("--link", "link", required=True, help=LINK_HELP)
+@set_option()
 @out_option("Results folder (default: results/<scenario name>-robot, numbered if it exists).")
 @overwrite_option()
 @no_progress_option()
 @no_plots_option()
+@strict_option()
 @click.option("--emulated", is_flag=True, help="Drive the six emulated slaves in this process instead of the robot, in lock-step on a virtual clock (free ports of the configured addresses, no real time: the same results on any machine).")
 @click.option("--stall-at", callback=_stall, default=None, help="T:MS, with --emulated: the master freezes T seconds after its start for MS milliseconds (virtual time), as a stopped process would: a rehearsal of a master overrun.")
 @_fault_options
-def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, emulated: bool, stall_at: tuple[float, float] | None, **faults) -> None:
+def run(scenario: str, link: str, overrides: dict, out: Path | None, overwrite: bool, no_progress: bool, no_plots: bool, strict: bool, emulated: bool, stall_at: tuple[float, float] | None, **faults) -> None:
     """Drive the robot with SCENARIO's controller through the link and save what the master saw.
 
     The master broadcasts the 18 motor commands every period, collects the six slave packets and
@@ -98,13 +100,14 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
     `safety_stop_reason`), and the exit status is 1 with that reason on one line. With
     --emulated the master drives `robot emulate`'s six slaves in lock-step instead (a rehearsal
     without timing), with the fault options of `robot emulate` and --stall-at to rehearse the
-    safety stops.
+    safety stops. --set changes the scenario's fields (its description then says so).
     """
-    from hexadyn import _core, energy, report
+    from hexadyn import _core, energy, health, report
     from hexadyn.runner import free_results_folder
     from hexadyn.results import Results
 
-    path = hexadyn.resolve_scenario(scenario)
+    chosen = hexadyn.Scenario.load(scenario).update(overrides)
+    path = chosen.path
     link_path = resolve_link(link)
     rehearsal = {"faults": _faults(**faults), "stall": stall_at} if emulated else {}
     if not emulated:
@@ -112,26 +115,27 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
         faulted = [name for name, value in [*faults.items(), ("stall_at", stall_at)] if value != defaults[name]]
         if faulted:
             raise click.ClickException(f"--{faulted[0].replace('_', '-')}: faults are rehearsed on the emulated slaves only; allowed with --emulated")
-    info = _core.load_scenario(str(path))
     if out is None:
-        out = free_results_folder(f"{info['name']}-robot")
+        out = free_results_folder(f"{chosen.name}-robot")
     elif out.exists() and not overwrite:
         raise click.ClickException(f"{out}: the results folder exists; use --overwrite or another --out")
+    fields = chosen.overrides() or None
     if no_progress:
-        raw = _core.robot_run(str(path), str(link_path), emulated=emulated, **rehearsal)
+        raw = _core.robot_run(str(path), str(link_path), overrides=fields, emulated=emulated, **rehearsal)
     else:
         from tqdm.auto import tqdm
 
-        with tqdm(total=info["duration_s"], desc=f"{info['name']} (robot)", unit="s", bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]") as bar:
-            raw = _core.robot_run(str(path), str(link_path), lambda t, _d: bar.update(max(0.0, t - bar.n)), emulated=emulated, **rehearsal)
+        with tqdm(total=chosen.duration_s, desc=f"{chosen.name} (robot)", unit="s", bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]") as bar:
+            raw = _core.robot_run(str(path), str(link_path), lambda t, _d: bar.update(max(0.0, t - bar.n)), fields, emulated=emulated, **rehearsal)
     results = Results.from_engine(raw, scenario_path=path)
     energy.add_energy_figures(results)
+    results.summary["warnings"] = health.check(results.summary)
     report.save(results, out, overwrite=overwrite)
-    if not no_plots:
+    if not no_plots and report.skipped_analysis(results) is None:
         _save_plots(results, out / report.PLOTS_DIR, progress=not no_progress)
     s = results.summary
     click.echo(f"Results: {out}")
-    click.echo(f"  scenario    {info['name']} ({path}) on the link {link_path}")
+    click.echo(f"  scenario    {chosen.name} ({path}) on the link {link_path}")
     click.echo(f"  ran         {s['duration_s']:.2f} s, {s['control_periods']} control periods, {s['missed_periods']} missed, real-time threads: {s['realtime']}")
     click.echo(f"  lateness    p50 {s['lateness_p50_s'] * 1e6:.1f} us, p99 {s['lateness_p99_s'] * 1e6:.1f} us, max {s['lateness_max_s'] * 1e6:.1f} us (broadcast against its deadline)")
     click.echo(f"  slaves      last packet p50 {s['last_reply_p50_s'] * 1e3:.2f} ms after the broadcast; controller p99 {s['controller_p99_s'] * 1e3:.3f} ms")
@@ -143,7 +147,9 @@ def run(scenario: str, link: str, out: Path | None, overwrite: bool, no_progress
         click.echo(f"    ... {len(raw['events']) - 10} more events")
     click.echo(f"  energy      electrical {s['energy_electrical_j']:.4g} J (sampled u i), max |u| {s['max_abs_voltage_v']:.2f} V")
     if raw["stop"] is not None:
+        warn_unhealthy(s["warnings"], strict=False)  # the safety stop's status 1 comes first
         raise click.ClickException(raw["stop"])
+    warn_unhealthy(s["warnings"], strict)
 
 
 def _save_plots(results, folder: Path, progress: bool) -> None:
@@ -163,9 +169,10 @@ def _save_plots(results, folder: Path, progress: bool) -> None:
 @robot.command("emulate")
 @click.argument("scenario")
 @click.option("--link", "link", required=True, help=LINK_HELP)
+@set_option()
 @_fault_options
 @click.option("--idle-timeout", type=click.FloatRange(0, min_open=True), default=None, help="Stop after this many seconds without a command, once the first came (default: run until Ctrl-C).")
-def emulate(scenario: str, link: str, idle_timeout: float | None, **faults) -> None:
+def emulate(scenario: str, link: str, overrides: dict, idle_timeout: float | None, **faults) -> None:
     """Emulate the six slave boards on SCENARIO's simulated robot.
 
     Each command packet applies the 18 duties to the multiphysics model, which advances one
@@ -173,16 +180,18 @@ def emulate(scenario: str, link: str, idle_timeout: float | None, **faults) -> N
     with the encoder counts, currents and supply of the model. The boards follow the master of
     their handshake (its address, port and run number) and refuse every other command; 50 ms
     without a command, their watchdog sets every output to 0 V. Faults are injected into the
-    slave packets as asked. Stop with Ctrl-C (or --idle-timeout).
+    slave packets as asked; --set changes the fields of the simulated robot's scenario. Stop
+    with Ctrl-C (or --idle-timeout).
     """
     from hexadyn import _core
 
-    path = hexadyn.resolve_scenario(scenario)
+    chosen = hexadyn.Scenario.load(scenario).update(overrides)
+    path = chosen.path
     link_path = resolve_link(link)
     def ready() -> None:
         click.echo(f"Emulating the six slaves of {path.stem} with the link {link_path}; Ctrl-C to stop", err=True)
 
-    report = _core.robot_emulate(str(path), str(link_path), _faults(**faults), idle_timeout, ready)
+    report = _core.robot_emulate(str(path), str(link_path), _faults(**faults), idle_timeout, ready, chosen.overrides() or None)
     f = {k: v for k, v in report["faults"].items() if v}
     click.echo(f"Emulator: {report['commands']} commands applied ({report['t']:.2f} s simulated), {report['sent']} packets sent, {report['ignored']} commands ignored (old), {report['rejected']} rejected")
     click.echo(f"  refused     {report['refused']} commands not from the boards' master; watchdog: outputs at 0 V {report['watchdog_trips']} time(s), 50 ms after a master's last command")

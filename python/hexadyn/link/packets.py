@@ -1,8 +1,9 @@
-"""Python mirror of the link packets (thesis Section 2.3.2; layout in ``docs/protocol.md``).
-
-It encodes byte for byte what the engine encodes (``hexadyn.link.protocol`` in Rust; the test
-suite compares both on random packets) and decodes with the same checks in the same order:
-size, CRC, version, ranges. For tools and tests: sniffing, replaying, writing a test slave.
+"""The link packets from Python (thesis Section 2.3.2; layout in ``docs/protocol.md``): typed
+values over the engine's codec (``_core.encode_command``, ``decode_command``,
+``encode_reply``, ``decode_reply``; the layout is defined once, in ``link/protocol.rs``, whose
+tests hold it to the byte dumps of docs/protocol.md), which decode with the engine's checks in
+the engine's order: size, CRC, version, ranges. For tools and tests: sniffing, replaying,
+writing a test slave; :func:`crc8_autosar` and :func:`crc16_ibm3740` forge packets.
 
 - Command packet, 36 bytes: 18 little-endian 16-bit words, word k for motor k = 3 leg + (0:
   q_r, 1: q_v, 2: q_h): bits 0-9 PWM duty, bit 10 direction (1: negative), bit 11 reserved
@@ -18,8 +19,11 @@ size, CRC, version, ranges. For tools and tests: sniffing, replaying, writing a 
 
 from __future__ import annotations
 
-import struct
+import binascii
 from dataclasses import dataclass
+from typing import Any, Callable
+
+from hexadyn import _core
 
 PROTOCOL_VERSION = 3
 #: Protocol version of the servo variant.
@@ -35,29 +39,23 @@ COUNT_MAX = (1 << 23) - 1
 #: Supply voltage of one least significant bit (V).
 SUPPLY_LSB_V = 0.1
 
-_DIRECTION_BIT = 1 << 10
-_RESERVED_BIT = 1 << 11
 _TORQUE_BIT = 1 << 11
-_HEADER_BYTES = JOINTS // 2
-_HEADER_SEQ, _HEADER_VERSION, _HEADER_CRC, _HEADER_RUN = 0, 2, 3, 5
-_CRC_WORDS = (6, 7, 8, 9)
 
 __all__ = ["PacketError", "MotorCommands", "ServoCommands", "SlaveReply", "SERVO_VERSION", "crc8_autosar", "crc16_ibm3740", "COMMAND_SIZE", "REPLY_SIZE", "PROTOCOL_VERSION"]
 
 
-def _crc_table(poly: int, width: int) -> list[int]:
-    top, mask = 1 << (width - 1), (1 << width) - 1
+def _crc8_table() -> list[int]:
+    """CRC-8/AUTOSAR's table (poly 0x2F, not reflected): the standard library has no CRC-8."""
     table = []
     for byte in range(256):
-        c = byte << (width - 8)
+        c = byte
         for _ in range(8):
-            c = ((c << 1) ^ poly) & mask if c & top else (c << 1) & mask
+            c = ((c << 1) ^ 0x2F) & 0xFF if c & 0x80 else (c << 1) & 0xFF
         table.append(c)
     return table
 
 
-_CRC8 = _crc_table(0x2F, 8)
-_CRC16 = _crc_table(0x1021, 16)
+_CRC8 = _crc8_table()
 
 
 def crc8_autosar(data: bytes) -> int:
@@ -69,11 +67,9 @@ def crc8_autosar(data: bytes) -> int:
 
 
 def crc16_ibm3740(data: bytes) -> int:
-    """CRC-16/IBM-3740 (CCITT): poly 0x1021, init 0xFFFF, xorout 0, not reflected (check 0x29B1)."""
-    c = 0xFFFF
-    for b in data:
-        c = ((c << 8) & 0xFFFF) ^ _CRC16[(c >> 8) ^ b]
-    return c
+    """CRC-16/IBM-3740 (CCITT-FALSE): poly 0x1021, init 0xFFFF, xorout 0, not reflected (check
+    0x29B1); the standard library's ``binascii.crc_hqx`` started at 0xFFFF."""
+    return binascii.crc_hqx(data, 0xFFFF)
 
 
 class PacketError(ValueError):
@@ -84,45 +80,24 @@ class PacketError(ValueError):
         self.kind = kind
 
 
-def _command_crc(data: bytes) -> int:
-    b = bytearray(data)
-    for w in _CRC_WORDS:
-        b[2 * w + 1] &= 0x0F
-    return crc16_ibm3740(bytes(b))
+#: What the engine's rejection of a datagram says, by kind (``PacketError`` of link/protocol.rs).
+_KINDS = (("size", " bytes, expected "), ("checksum", "): corrupted"), ("version", ", this side speaks "), ("range", " out of range; allowed: "))
 
 
-def _encode_command(seq: int, run: int, bits: list[int], version: int) -> bytes:
-    """The command packet of `version` with the 12 setpoint bits of each word."""
-    header = bytearray(_HEADER_BYTES)
-    header[_HEADER_SEQ : _HEADER_SEQ + 2] = seq.to_bytes(2, "little")
-    header[_HEADER_VERSION] = version
-    header[_HEADER_RUN:] = run.to_bytes(4, "little")
-    words = [b | ((header[k // 2] >> (4 * (k % 2))) & 0x0F) << 12 for k, b in enumerate(bits)]
-    data = bytearray(struct.pack("<18H", *words))
-    crc = _command_crc(bytes(data))
-    for i, w in enumerate(_CRC_WORDS):
-        data[2 * w + 1] = (data[2 * w + 1] & 0x0F) | ((crc >> (4 * i)) & 0x0F) << 4
-    return bytes(data)
-
-
-def _decode_command(data: bytes, version: int) -> tuple[int, int, tuple[int, ...]]:
-    """(seq, run, the 18 words) of a command packet of `version`, checked as the engine checks it."""
-    if len(data) != COMMAND_SIZE:
-        raise PacketError("size", f"{len(data)} bytes, expected {COMMAND_SIZE}")
-    words = struct.unpack("<18H", data)
-    header = bytearray(_HEADER_BYTES)
-    for k, w in enumerate(words):
-        header[k // 2] |= (w >> 12) << (4 * (k % 2))
-    computed = _command_crc(data)
-    received = int.from_bytes(header[_HEADER_CRC : _HEADER_CRC + 2], "little")
-    if computed != received:
-        raise PacketError("checksum", f"CRC {received:#06x} does not match the content ({computed:#06x}): corrupted")
-    if header[_HEADER_VERSION] != version:
-        raise PacketError("version", f"protocol version {header[_HEADER_VERSION]}, this side speaks {version}")
-    return int.from_bytes(header[_HEADER_SEQ : _HEADER_SEQ + 2], "little"), int.from_bytes(header[_HEADER_RUN:], "little"), words
+def _decoded(decode: Callable[[bytes, int], Any], data: bytes, version: int) -> Any:
+    """`decode` (an engine decoder) of `data`; its rejection as a :class:`PacketError`."""
+    try:
+        return decode(bytes(data), version)
+    except ValueError as exc:
+        message = str(exc)
+        kind = next((k for k, said in _KINDS if said in message), None)
+        if kind is None:
+            raise
+        raise PacketError(kind, message) from None
 
 
 def _check_header(seq: int, run: int) -> None:
+    """The header's fields in their ranges (the engine takes them as u16 and u32)."""
     if not 0 <= seq <= 0xFFFF or not 0 <= run <= 0xFFFF_FFFF:
         raise ValueError(f"seq = {seq}, run = {run}: allowed 0..65535 and 0..4294967295")
 
@@ -138,17 +113,12 @@ class MotorCommands:
 
     def encode(self) -> bytes:
         _check_header(self.seq, self.run)
-        if len(self.duties) != JOINTS or any(abs(d) > DUTY_MAX for d in self.duties):
-            raise ValueError(f"duties = {self.duties}: allowed 18 integers in -1023..1023")
-        return _encode_command(self.seq, self.run, [abs(d) | (_DIRECTION_BIT if d < 0 else 0) for d in self.duties], PROTOCOL_VERSION)
+        return _core.encode_command(self.seq, list(self.duties), PROTOCOL_VERSION, self.run)
 
     @classmethod
     def decode(cls, data: bytes) -> "MotorCommands":
-        seq, run, words = _decode_command(data, PROTOCOL_VERSION)
-        if any(w & _RESERVED_BIT for w in words):
-            raise PacketError("range", "command word bit 11 (reserved) is set")
-        duties = tuple(-(w & DUTY_MAX) if w & _DIRECTION_BIT else w & DUTY_MAX for w in words)
-        return cls(seq, duties, run)
+        seq, run, duties = _decoded(_core.decode_command, data, PROTOCOL_VERSION)
+        return cls(seq, tuple(duties), run)
 
 
 @dataclass(frozen=True)
@@ -170,14 +140,12 @@ class ServoCommands:
 
     def encode(self) -> bytes:
         _check_header(self.seq, self.run)
-        if len(self.words) != JOINTS or any(not 0 <= w <= 0x0FFF for w in self.words):
-            raise ValueError(f"words = {self.words}: allowed 18 integers in 0..4095")
-        return _encode_command(self.seq, self.run, list(self.words), SERVO_VERSION)
+        return _core.encode_command(self.seq, list(self.words), SERVO_VERSION, self.run)
 
     @classmethod
     def decode(cls, data: bytes) -> "ServoCommands":
-        seq, run, words = _decode_command(data, SERVO_VERSION)
-        return cls(seq, tuple(w & 0x0FFF for w in words), run)
+        seq, run, words = _decoded(_core.decode_command, data, SERVO_VERSION)
+        return cls(seq, tuple(words), run)
 
 
 @dataclass(frozen=True)
@@ -197,39 +165,19 @@ class SlaveReply:
         return self.supply / 10.0
 
     def encode(self, version: int = PROTOCOL_VERSION) -> bytes:
-        """The packet of `version` (3: encoder counts; 4: servo positions 0..2047)."""
+        """The packet of `version` (3: encoder counts; 4: servo positions 0..2047); ValueError
+        for a field out of its range (the engine's encoder saturates them, as a board does)."""
         low, high = _count_range(version)
         if not 0 <= self.leg < 6 or not 0 <= self.seq <= 0xFFFF or not 0 <= self.supply <= 255:
             raise ValueError(f"leg = {self.leg}, seq = {self.seq}, supply = {self.supply}: allowed 0..5, 0..65535, 0..255")
         if any(not low <= c <= high for c in self.counts) or any(abs(i) > CURRENT_MAX_MA for i in self.currents_ma):
             raise ValueError(f"counts = {self.counts}, currents = {self.currents_ma} mA: allowed counts {low}..{high}, |i| <= 25000 mA")
-        data = bytearray([version << 4 | self.leg]) + self.seq.to_bytes(2, "little")
-        for c in self.counts:
-            data += (c & 0xFFFFFF).to_bytes(3, "little")
-        data += struct.pack("<3hB", *self.currents_ma, self.supply)
-        data.append(crc8_autosar(bytes(data)))
-        return bytes(data)
+        return _core.encode_reply(self.leg, self.seq, list(self.counts), list(self.currents_ma), self.supply, version)
 
     @classmethod
     def decode(cls, data: bytes, version: int = PROTOCOL_VERSION) -> "SlaveReply":
-        low, high = _count_range(version)
-        if len(data) != REPLY_SIZE:
-            raise PacketError("size", f"{len(data)} bytes, expected {REPLY_SIZE}")
-        computed = crc8_autosar(data[:-1])
-        if computed != data[-1]:
-            raise PacketError("checksum", f"CRC {data[-1]:#06x} does not match the content ({computed:#06x}): corrupted")
-        leg = data[0] & 0x0F
-        if data[0] >> 4 != version:
-            raise PacketError("version", f"protocol version {data[0] >> 4}, this side speaks {version}")
-        if leg >= 6:
-            raise PacketError("range", f"leg = {leg} out of range; allowed: 0..5")
-        counts = tuple(int.from_bytes(data[3 + 3 * j : 6 + 3 * j], "little", signed=True) for j in range(3))
-        if any(not low <= c <= high for c in counts):
-            raise PacketError("range", f"position count = {counts} out of range; allowed: {low}..{high}")
-        *currents, supply = struct.unpack("<3hB", data[12:19])
-        if any(abs(i) > CURRENT_MAX_MA for i in currents):
-            raise PacketError("range", f"motor current (mA) = {currents} out of range; allowed: -25000..25000")
-        return cls(leg, int.from_bytes(data[1:3], "little"), counts, tuple(currents), supply)
+        leg, seq, counts, currents, supply = _decoded(_core.decode_reply, data, version)
+        return cls(leg, seq, tuple(counts), tuple(currents), supply)
 
 
 def _count_range(version: int) -> tuple[int, int]:

@@ -23,6 +23,7 @@ influence, so only the ``dry_viscous`` variant.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -33,11 +34,11 @@ from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
 from hexadyn.montecarlo.execution import Executor, ProcessPool, Progress, Ray
 from hexadyn.montecarlo.sampling import FrictionDistributions, draw_friction, read_friction_stats
-from hexadyn.montecarlo.storage import CampaignStore, RunKey
+from hexadyn.montecarlo.storage import WARNINGS_COLUMN, CampaignStore, RunKey
 from hexadyn.montecarlo.tables import specific_resistance_table, write_results
 from hexadyn.runner import resolve_scenario
 
-__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "Campaign", "run_campaign", "study_tables", "variant_fields", "variants_of"]
+__all__ = ["DEFAULT_SCENARIO", "DEFAULT_SCENARIOS", "MAX_SIMULATIONS", "VARIANTS", "DEFAULT_VARIANTS", "Campaign", "run_campaign", "study_tables", "variant_fields", "variants_of"]
 
 #: Scenario of a campaign without an explicit one: the Table 6.2 validation walk.
 DEFAULT_SCENARIO = "validation_tripod_1_5cm"
@@ -45,8 +46,18 @@ DEFAULT_SCENARIO = "validation_tripod_1_5cm"
 #: The campaign scenario of each shipped robot (``hexadyn montecarlo --robot NAME``).
 DEFAULT_SCENARIOS = {"amru5": DEFAULT_SCENARIO, "phantomx": "phantomx_montecarlo"}
 
-#: Friction variants of Section 6.5 -> whether the load influence of Eq. 5.12 is on.
-VARIANTS = {"dry_viscous": False, "dry_viscous_load": True}
+#: Friction variants -> the scenario fields selecting their model: those of Section 6.5,
+#: dry/viscous (Eq. 6.1) without and with the load influence of Eq. 5.12, and the transmission
+#: efficiency of the thesis' prospects (Chapter 8), whose no-load friction is drawn as the
+#: dry/viscous one and whose efficiencies are the robot's unless a friction statistics file
+#: gives their distributions (``hexadyn identify`` of loaded logs).
+VARIANTS = {
+    "dry_viscous": {"model.friction": "dry_viscous", "model.load_dependence": False},
+    "dry_viscous_load": {"model.friction": "dry_viscous", "model.load_dependence": True},
+    "efficiency": {"model.friction": "efficiency", "model.load_dependence": False},
+}
+#: The variants of a campaign that names none: Section 6.5's (those the robot allows).
+DEFAULT_VARIANTS = ("dry_viscous", "dry_viscous_load")
 
 #: The most simulations (runs x velocities x variants) a campaign may hold: 125 times the
 #: thesis' 8000 (1000 runs, 4 velocities, 2 variants), four and a half days of 60 s walks on
@@ -55,9 +66,16 @@ MAX_SIMULATIONS = 1_000_000
 
 
 def variant_fields(variant: str) -> dict[str, Any]:
-    """The scenario fields that select a variant's friction model: dry/viscous (Eq. 6.1),
-    with or without the load influence of Eq. 5.12."""
-    return {"model.friction": "dry_viscous", "model.load_dependence": VARIANTS[variant]}
+    """The scenario fields that select a variant's friction model (:data:`VARIANTS`)."""
+    return dict(VARIANTS[variant])
+
+
+def drawn_by(distributions: FrictionDistributions, variant: str) -> dict[str, tuple[float, float]]:
+    """The Gaussians a variant's runs use: the load coefficients of Eq. 5.12 only with the
+    load influence, the efficiencies only with the efficiency law."""
+    load = VARIANTS[variant]["model.load_dependence"]
+    efficiency = VARIANTS[variant]["model.friction"] == "efficiency"
+    return {f: g for f, g in distributions.gaussians.items() if (load or f not in distributions.load_parameters) and (efficiency or f not in distributions.efficiency_parameters)}
 
 
 def study_tables(distributions: FrictionDistributions, variant: str = "dry_viscous") -> dict[str, dict[str, Any]]:
@@ -67,8 +85,7 @@ def study_tables(distributions: FrictionDistributions, variant: str = "dry_visco
     :func:`draw_friction` samples by rejection), a field of zero sigma and the robot's fixed
     fields set as ``[fixed]`` with the variant's friction model. A study of these tables
     samples what the campaign draws (its design instead of independent draws)."""
-    load = VARIANTS[variant]
-    fields = {f: g for f, g in distributions.gaussians.items() if load or f not in distributions.load_parameters}
+    fields = drawn_by(distributions, variant)
     parameters = {f: {"distribution": "truncated_normal", "range": list(distributions.accepted_interval(f)), "mean": mu, "std": sigma} for f, (mu, sigma) in fields.items() if sigma > 0}
     fixed = {**variant_fields(variant), **distributions.fixed, **{f: mu for f, (mu, sigma) in fields.items() if sigma == 0}}
     return {"fixed": fixed, "parameters": parameters}
@@ -76,8 +93,9 @@ def study_tables(distributions: FrictionDistributions, variant: str = "dry_visco
 
 def variants_of(distributions: FrictionDistributions) -> tuple[str, ...]:
     """The variants a robot's set-up allows: the load influence needs drawn load coefficients
-    (AMRU5's horizontal joints, Eq. 5.12); a serial robot has ``dry_viscous`` only."""
-    return tuple(v for v, load in VARIANTS.items() if not load or distributions.load_parameters)
+    (AMRU5's horizontal joints, Eq. 5.12); a serial robot has ``dry_viscous`` and
+    ``efficiency``."""
+    return tuple(v for v, fields in VARIANTS.items() if not fields["model.load_dependence"] or distributions.load_parameters)
 
 
 @dataclass(frozen=True)
@@ -133,7 +151,7 @@ class Campaign:
         if not velocities or not all(math.isfinite(v) and v > 0 for v in velocities):
             raise ValueError(f"velocities = {list(velocities)}: need one or more finite velocities > 0 (m/s)")
         allowed = variants_of(distributions)
-        variants = tuple(allowed if variants is None else variants)
+        variants = tuple(v for v in allowed if v in DEFAULT_VARIANTS) if variants is None else tuple(variants)
         unknown = [v for v in variants if v not in allowed]
         if unknown or not variants or len(set(variants)) != len(variants):
             why = "" if len(allowed) == len(VARIANTS) else f" (no load influence on the legs of {distributions.robot})"
@@ -162,9 +180,8 @@ class Campaign:
         """The ``[model.joint_friction]`` fields of a run: the draw of (velocity, run) without
         the load coefficients for the variant without load influence, and the fixed values."""
         drawn = draw_friction(self.distributions, self.seed, key.velocity_index, key.run_index)
-        if not VARIANTS[key.variant]:
-            drawn = {k: v for k, v in drawn.items() if k not in self.distributions.load_parameters}
-        return {**drawn, **self.distributions.fixed}
+        used = drawn_by(self.distributions, key.variant)
+        return {**{k: v for k, v in drawn.items() if k in used}, **self.distributions.fixed}
 
     def overrides(self, key: RunKey) -> dict[str, Any]:
         """The scenario overrides of a run."""
@@ -205,7 +222,8 @@ class Campaign:
         more workers than runs left to simulate. On Ctrl-C (KeyboardInterrupt, also raised by
         ``progress``) the running simulations are stopped and the finished ones are kept:
         running again resumes. Failed simulations are stored and counted in the table's
-        ``failed`` column (:meth:`failures` lists them).
+        ``failed`` column (:meth:`failures` lists them); so are the failed health checks of
+        each run (:meth:`unhealthy` lists the runs with any).
         """
         executor: Executor = Ray(ray, workers) if ray else ProcessPool(workers)
         keys = self.keys()
@@ -221,9 +239,23 @@ class Campaign:
     def failures(self, out: str | os.PathLike):
         """The failed simulations stored in the campaign folder ``out``: a DataFrame of
         ``variant``, ``velocity_m_s``, ``run_index`` and ``error``, in run order."""
-        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
-            runs = store.runs()
+        runs = self._runs(out)
         return runs.loc[runs["status"] != "ok", ["variant", "velocity_m_s", "run_index", "error"]].reset_index(drop=True)
+
+    def unhealthy(self, out: str | os.PathLike):
+        """The simulations stored in the campaign folder ``out`` that failed a health check
+        (:func:`hexadyn.health.check`): a DataFrame of ``variant``, ``velocity_m_s``,
+        ``run_index`` and ``warnings`` (the list of the failed checks), in run order. Runs
+        stored by a hexadyn that did not record the checks (``warnings`` NULL) are not listed."""
+        runs = self._runs(out)
+        runs = runs.loc[runs["status"] == "ok", ["variant", "velocity_m_s", "run_index", WARNINGS_COLUMN]]
+        runs[WARNINGS_COLUMN] = [json.loads(w) if isinstance(w, str) else [] for w in runs[WARNINGS_COLUMN]]  # NULL (NaN): not checked
+        return runs[runs[WARNINGS_COLUMN].map(bool)].reset_index(drop=True)
+
+    def _runs(self, out: str | os.PathLike):
+        """Every run stored in the campaign folder ``out`` (:meth:`CampaignStore.runs`)."""
+        with CampaignStore.open(out, self.configuration(), self.distributions.joints) as store:
+            return store.runs()
 
     def _simulate(self, store: CampaignStore, executor: Executor, pending: list[RunKey], total: int, progress: Progress) -> None:
         def stored(key: RunKey, outcome: dict[str, Any]) -> list[tuple[str, dict[str, Any]]]:

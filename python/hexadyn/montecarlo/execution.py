@@ -4,9 +4,9 @@ pool) or on Ray.
 Both executors take a picklable function and (key, payload) tasks, and yield (key,
 ``function(payload)``) as the tasks finish, in any order; the caller (the parent process, or the
 Ray driver) stores the results. A Monte Carlo campaign's function is :func:`simulate_run` of its
-scenario, whose outcome is ``{"status": "ok", "summary": {...}}`` (the entries of
-:func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints) or ``{"status":
-"failed", "error": message}`` for a simulation the engine rejected (ValueError); any exception
+scenario, whose outcome is ``{"status": "ok", "summary": {...}, "warnings": [...]}`` (the
+entries of :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints, and the
+failed health checks of the run) or ``{"status": "failed", "error": message}`` for a simulation the engine rejected (ValueError); any exception
 stops the campaign. Closing the generator (Ctrl-C, an exception in the caller) cancels the
 tasks not finished yet and stops the workers.
 """
@@ -74,10 +74,11 @@ def run_and_store(executor: Executor, function: Callable[[Any], Any], tasks: Ite
 def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[str] | None = None) -> dict[str, Any]:
     """Runs one simulation and returns its outcome: the summary ``entries`` (default: the
     :func:`~hexadyn.montecarlo.storage.summary_columns` of the robot's joints, the split of E
-    per joint under the robot's joint names). The engine's summary alone (no time series)
-    unless an entry is one of :data:`SERIES_FIGURES`: then the run is :func:`hexadyn.simulate`'s,
-    series in memory. An entry the summary lacks is None."""
-    from hexadyn import _core
+    per joint under the robot's joint names) and the failed health checks of the run
+    (:func:`hexadyn.health.check`, as :func:`hexadyn.simulate` makes them). The engine's
+    summary alone (no time series) unless an entry is one of :data:`SERIES_FIGURES`: then the
+    run is :func:`hexadyn.simulate`'s, series in memory. An entry the summary lacks is None."""
+    from hexadyn import _core, health
     from hexadyn.vocabulary import Joints
 
     try:
@@ -87,11 +88,11 @@ def simulate_run(scenario: str, overrides: Mapping[str, Any], entries: Sequence[
             summary = simulate(scenario, progress=False, overrides=overrides).summary
         else:
             raw = _core.run_scenario(scenario, None, dict(overrides), timeseries=False)
-            summary = raw["summary"]
+            summary = {**raw["summary"], "warnings": health.check(raw["summary"])}
             entries = summary_columns(Joints.of_robot(raw["robot"]).names) if entries is None else entries
     except ValueError as exc:
         return {"status": "failed", "error": " ".join(str(exc).split())}
-    return {"status": "ok", "summary": {c: summary.get(c) for c in entries}}
+    return {"status": "ok", "summary": {c: summary.get(c) for c in entries}, "warnings": summary["warnings"]}
 
 
 def _several(function: Callable[[Any], Any]) -> Callable[[list[Any]], list[Any]]:

@@ -11,8 +11,13 @@ before any draw (:meth:`FrictionDistributions.check`): rejection would take more
 
 A run is identified by (velocity index, run index); its random stream is
 ``np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(velocity_index, run_index)))``,
-so a draw does not depend on scheduling, worker count or interruptions. Both friction variants
-of a run use the same draw (common random numbers).
+so a draw does not depend on scheduling, worker count or interruptions. Every friction variant
+of a run uses the same draw (common random numbers).
+
+The efficiencies of the transmission-efficiency friction (the thesis' prospects, Chapter 8) are
+drawn only when friction statistics give them (``hexadyn identify`` of sawtooth logs at several
+foot loads), after the robot's Gaussians: the draws of the other parameters stay those of the
+robot's set-up.
 """
 
 from __future__ import annotations
@@ -26,12 +31,17 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FrictionDistributions", "MIN_ACCEPTANCE", "draw_friction", "read_friction_stats"]
+__all__ = ["FrictionDistributions", "MIN_ACCEPTANCE", "EFFICIENCY_KEYS", "draw_friction", "read_friction_stats"]
 
 #: The smallest probability of a draw to be kept (within +- truncation_sigmas and physical)
 #: a distribution may have: at most 100 draws per kept value on average. The shipped robots'
 #: lowest is 0.91 (AMRU5's q_r f_v^+, Table 6.7: N(3.46, 2.55^2) kept at or above 0).
 MIN_ACCEPTANCE = 0.01
+
+#: The keys of a joint's efficiencies (``model.joint_friction.<joint>.eta_forward``) and their
+#: physical values, 0 < eta <= 1 (the law of ``physics/friction.rs``).
+EFFICIENCY_KEYS = ("eta_forward", "eta_backward")
+EFFICIENCY_BOUNDS = (math.nextafter(0.0, 1.0), 1.0)
 
 
 @dataclass(frozen=True)
@@ -82,16 +92,29 @@ class FrictionDistributions:
             joints=tuple(d["joints"]),
         )
 
+    @property
+    def efficiency_parameters(self) -> tuple[str, ...]:
+        """The fields of ``gaussians`` acting only with the efficiency law."""
+        return tuple(f for f in self.gaussians if self._is_efficiency(f))
+
+    def _is_efficiency(self, field: str) -> bool:
+        prefix, _, key = field.rpartition(".")
+        return key in EFFICIENCY_KEYS and prefix in {f"model.joint_friction.{j}" for j in self.joints}
+
     def with_stats(self, stats: dict[str, tuple[float, float]], source: str) -> FrictionDistributions:
         """The same set-up with the Gaussians of `stats` (scenario field -> (mu, sigma), e.g.
-        identified by ``hexadyn identify``) in place of the robot's. Fields the robot's set-up
-        holds fixed (the horizontal viscous slopes, neglected in Section 6.5) are left fixed;
-        any other field not drawn is an error naming `source`."""
-        unknown = [f for f in stats if f not in self.gaussians and f not in self.fixed]
+        identified by ``hexadyn identify``) in place of the robot's, and the joints'
+        efficiencies it gives drawn after them. Fields the robot's set-up holds fixed (the
+        horizontal viscous slopes, neglected in Section 6.5) are left fixed; any other field
+        not drawn is an error naming `source`."""
+        unknown = [f for f in stats if f not in self.gaussians and f not in self.fixed and not self._is_efficiency(f)]
         if unknown:
-            raise ValueError(f"{source}: {', '.join(unknown)}: not a friction parameter of the Monte Carlo runs; allowed: {', '.join(self.gaussians)}")
+            efficiencies = f"model.joint_friction.<{'|'.join(self.joints)}>.<{'|'.join(EFFICIENCY_KEYS)}>"
+            raise ValueError(f"{source}: {', '.join(unknown)}: not a friction parameter of the Monte Carlo runs; allowed: {', '.join(self.gaussians)}, {efficiencies}")
         gaussians = {f: stats.get(f, g) for f, g in self.gaussians.items()}
-        return dataclasses.replace(self, gaussians=gaussians)
+        added = {f: g for f, g in stats.items() if f not in gaussians and self._is_efficiency(f)}
+        bounds = {**self.physical_bounds, **{f: EFFICIENCY_BOUNDS for f in added}}
+        return dataclasses.replace(self, gaussians={**gaussians, **added}, physical_bounds=bounds)
 
     def accepted_interval(self, field: str) -> tuple[float, float]:
         """The values a draw of ``field`` keeps: mu +- truncation_sigmas sigma, physical ones.

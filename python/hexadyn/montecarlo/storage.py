@@ -9,7 +9,8 @@ configuration. ``runs.sqlite`` has one row per finished simulation in the table 
 by (variant, velocity_index, run_index), written by the parent process in one transaction per
 run: an interrupted campaign loses at most the runs that were still being simulated, and the
 primary key forbids duplicates. Failed simulations are stored too (status ``failed`` and the
-error message), so a resumed campaign does not retry them.
+error message), so a resumed campaign does not retry them. A campaign's run keeps its failed
+health checks (``warnings``, a JSON list; NULL for a run stored before hexadyn recorded them).
 
 ``campaign.json`` is written atomically (:func:`hexadyn.atomic.write_file`), the output files
 (table and figures) as one set (:func:`hexadyn.montecarlo.tables.write_results`). A
@@ -29,12 +30,14 @@ from typing import Any, Mapping, NamedTuple, Sequence
 
 from hexadyn import atomic
 
-__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "SUMMARY_COLUMNS", "CampaignStore", "Layout", "RunKey", "RunStore", "campaign_layout", "per_joint_columns", "summary_columns"]
+__all__ = ["CAMPAIGN_FILE", "DATABASE_FILE", "WARNINGS_COLUMN", "SUMMARY_COLUMNS", "CampaignStore", "Layout", "RunKey", "RunStore", "campaign_layout", "per_joint_columns", "summary_columns"]
 
 CAMPAIGN_FILE = "campaign.json"
 DATABASE_FILE = "runs.sqlite"
 #: Identifies a hexadyn Monte Carlo folder in campaign.json.
 FORMAT = "hexadyn-montecarlo"
+#: The column of a campaign's runs holding their failed health checks (JSON list).
+WARNINGS_COLUMN = "warnings"
 
 #: The joints of AMRU5's legs, whose names the per-joint columns of its campaigns carry.
 AMRU5_JOINTS = ("q_r", "q_v", "q_h")
@@ -100,9 +103,10 @@ def _quoted(name: str) -> str:
 
 def campaign_layout(joints: Sequence[str] = AMRU5_JOINTS) -> Layout:
     """A Monte Carlo campaign's folder: runs keyed by (variant, velocity_index, run_index), with
-    the velocity, the drawn friction (JSON) and the :func:`summary_columns` of the robot's joints."""
+    the velocity, the drawn friction (JSON), the :func:`summary_columns` of the robot's joints
+    and the failed health checks (:data:`WARNINGS_COLUMN`)."""
     keys = {"variant": "TEXT", "velocity_index": "INTEGER", "run_index": "INTEGER"}
-    columns = {"velocity_m_s": "REAL NOT NULL", "parameters": "TEXT NOT NULL", **{c: "REAL" for c in summary_columns(joints)}}
+    columns = {"velocity_m_s": "REAL NOT NULL", "parameters": "TEXT NOT NULL", **{c: "REAL" for c in summary_columns(joints)}, WARNINGS_COLUMN: "TEXT"}
     return Layout("Monte Carlo campaign", FORMAT, CAMPAIGN_FILE, keys, columns)
 
 
@@ -143,6 +147,7 @@ class RunStore:
         try:
             with _readable(folder / DATABASE_FILE, layout), connection:
                 connection.execute(layout.schema())
+                _add_new_columns(connection, layout)
         except BaseException:
             connection.close()
             raise
@@ -195,8 +200,8 @@ class CampaignStore(RunStore):
 
     @property
     def columns(self) -> tuple[str, ...]:
-        """The summary columns of the runs."""
-        return tuple(self.layout.columns)[2:]
+        """The summary columns of the runs (between the drawn friction and the warnings)."""
+        return tuple(self.layout.columns)[2:-1]
 
     def finished(self) -> set[RunKey]:  # type: ignore[override]
         """The runs stored so far (succeeded or failed)."""
@@ -205,11 +210,25 @@ class CampaignStore(RunStore):
     def add(self, key: RunKey, velocity_m_s: float, parameters: Mapping[str, Any], outcome: Mapping[str, Any]) -> None:
         """Stores one finished run in its own transaction.
 
-        ``outcome`` is ``{"status": "ok", "summary": {...}}`` or ``{"status": "failed",
-        "error": message}``. A run already stored is an error (sqlite3.IntegrityError).
+        ``outcome`` is ``{"status": "ok", "summary": {...}, "warnings": [...]}`` or ``{"status":
+        "failed", "error": message}``. A run already stored is an error (sqlite3.IntegrityError).
         """
         row = {**outcome.get("summary", {}), **key._asdict(), "velocity_m_s": velocity_m_s, "parameters": json.dumps(dict(parameters))}
+        if "warnings" in outcome:
+            row[WARNINGS_COLUMN] = json.dumps(list(outcome["warnings"]))
         self.add_rows([{**row, "status": outcome["status"], "error": outcome.get("error")}])
+
+
+def _add_new_columns(connection: sqlite3.Connection, layout: Layout) -> None:
+    """Adds to a ``runs`` table stored by an earlier hexadyn the nullable columns of `layout` it
+    lacks (its runs get NULL there), so that its campaign resumes; a table without the key
+    columns is not one of ours and is left to fail on use."""
+    present = {row[1] for row in connection.execute("PRAGMA table_info(runs)")}
+    if not set(layout.keys) <= present:
+        return
+    for column, kind in layout.columns.items():
+        if column not in present and "NOT NULL" not in kind:
+            connection.execute(f"ALTER TABLE runs ADD COLUMN {_quoted(column)} {kind}")
 
 
 @contextmanager

@@ -13,7 +13,7 @@ from hexadyn.montecarlo.storage import DATABASE_FILE
 if TYPE_CHECKING:  # pandas is imported when a table is made: the Ray workers import this package, not pandas
     import pandas as pd
 
-__all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "failure_line", "write_results", "write_table", "plot_specific_resistance"]
+__all__ = ["TABLE_FILE", "TABLE_COLUMNS", "FIGURE_FILES", "specific_resistance_table", "failure_line", "warning_line", "write_results", "write_table", "plot_specific_resistance"]
 
 TABLE_FILE = "specific_resistance.csv"
 FIGURE_FILES = ("specific_resistance.png", "specific_resistance.pdf")
@@ -65,18 +65,30 @@ def failure_line(failed: pd.DataFrame, total: int, folder: str | os.PathLike) ->
     """One line naming the failed simulations of a campaign (:meth:`Campaign.failures
     <hexadyn.montecarlo.Campaign.failures>`) of `total`, by variant and velocity, with the first
     error and where they are kept."""
+    first = failed.iloc[0]
+    return f"{len(failed)} of {total} simulations failed: {_runs_named(failed)}: {first['error']}; kept as failed in {Path(folder) / DATABASE_FILE} (not retried)"
+
+
+def warning_line(unhealthy: pd.DataFrame, total: int, folder: str | os.PathLike) -> str:
+    """One line naming the simulations of a campaign that failed a health check
+    (:meth:`Campaign.unhealthy <hexadyn.montecarlo.Campaign.unhealthy>`) of `total`, by variant
+    and velocity, with the first one's failed checks and where they are kept."""
+    first = unhealthy.iloc[0]
+    return f"{len(unhealthy)} of {total} simulations failed a health check: {_runs_named(unhealthy)}: {'; '.join(first['warnings'])} (column warnings of {Path(folder) / DATABASE_FILE})"
+
+
+def _runs_named(runs: pd.DataFrame) -> str:
+    """Runs of a campaign by variant and velocity (the first :data:`_SHOWN` groups and run
+    indices of each), then the first run: ``dry_viscous at V_x = 0.01 m/s (2: run 0, 1); the
+    first (dry_viscous, V_x = 0.01 m/s, run 0)``."""
     groups = []
-    for (variant, velocity), runs in failed.groupby(["variant", "velocity_m_s"], sort=False):
-        indices = runs["run_index"].tolist()
+    for (variant, velocity), group in runs.groupby(["variant", "velocity_m_s"], sort=False):
+        indices = group["run_index"].tolist()
         shown = ", ".join(map(str, indices[:_SHOWN])) + (", ..." if len(indices) > _SHOWN else "")
         groups.append(f"{variant} at V_x = {velocity:g} m/s ({len(indices)}: run {shown})")
     more = f" and {len(groups) - _SHOWN} more" if len(groups) > _SHOWN else ""
-    first = failed.iloc[0]
-    return (
-        f"{len(failed)} of {total} simulations failed: {'; '.join(groups[:_SHOWN])}{more}; "
-        f"the first ({first['variant']}, V_x = {first['velocity_m_s']:g} m/s, run {first['run_index']}): {first['error']}; "
-        f"kept as failed in {Path(folder) / DATABASE_FILE} (not retried)"
-    )
+    first = runs.iloc[0]
+    return f"{'; '.join(groups[:_SHOWN])}{more}; the first ({first['variant']}, V_x = {first['velocity_m_s']:g} m/s, run {first['run_index']})"
 
 
 #: Groups and run indices a failure line names before "...".

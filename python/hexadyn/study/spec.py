@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, NoReturn
 
+from hexadyn.fields import is_field_value
+
 __all__ = ["DISTRIBUTIONS", "METHODS", "Design", "Parameter", "StudySpec", "parse_study", "read_study"]
 
 #: The designs: a full factorial grid, a Latin hypercube, Sobol' with Saltelli's scheme, Morris.
@@ -156,8 +158,10 @@ def parse_study(table: Mapping[str, Any], source: str = "study", *, name: str = 
     check.keys("study", study, ("name", "description", "scenario", "outputs", "seed"), required=("outputs",))
     outputs = check.names("study.outputs", study["outputs"])
     fixed = check.table("fixed", table.get("fixed", {}))
-    for key in fixed:
+    for key, value in fixed.items():
         check.key("fixed", key)
+        if not is_field_value(value):
+            check.bad(f"fixed.\"{key}\"", value, "a value a scenario field holds: a boolean, a number, a string, or a list or table of them (not a date or a time)")
     design = _design(check, check.table("design", table["design"]))
     parameters = check.table("parameters", table["parameters"])
     if not parameters:

@@ -15,6 +15,7 @@ the machinery); everything else follows the same path.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import os
 from dataclasses import dataclass
@@ -27,7 +28,7 @@ from hexadyn import atomic
 from hexadyn._core import __version__
 from hexadyn.montecarlo import execution
 from hexadyn.montecarlo.execution import SERIES_FIGURES, Executor, ProcessPool, Progress, Ray
-from hexadyn.montecarlo.storage import Layout, RunStore
+from hexadyn.montecarlo.storage import WARNINGS_COLUMN, Layout, RunStore
 from hexadyn.study import analysis, design
 from hexadyn.study.spec import StudySpec, read_study
 
@@ -62,7 +63,7 @@ class ScenarioModel:
         outcome = execution.simulate_run(self.scenario, {**self.fixed, **parameters}, self.outputs)
         if outcome["status"] != "ok":
             return outcome
-        return {"status": "ok", "outputs": outcome["summary"]}
+        return {"status": "ok", "outputs": outcome["summary"], "warnings": outcome["warnings"]}
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,15 @@ class StudyResults:
     def failures(self) -> pd.DataFrame:
         """The failed runs: ``run_index`` and ``error``."""
         return self.runs.loc[self.runs["status"] != "ok", ["run_index", "error"]].reset_index(drop=True)
+
+    @property
+    def unhealthy(self) -> pd.DataFrame:
+        """The runs of a scenario that failed a health check (:func:`hexadyn.health.check`):
+        ``run_index`` and ``warnings`` (the list of the failed checks), in run order."""
+        runs = self.runs if WARNINGS_COLUMN in self.runs else self.runs.assign(**{WARNINGS_COLUMN: None})
+        runs = runs.loc[runs["status"] == "ok", ["run_index", WARNINGS_COLUMN]].copy()
+        runs[WARNINGS_COLUMN] = [json.loads(w) if isinstance(w, str) else [] for w in runs[WARNINGS_COLUMN]]
+        return runs[runs[WARNINGS_COLUMN].map(bool)].reset_index(drop=True)
 
 
 @dataclass(frozen=True)
@@ -147,6 +157,8 @@ class Study:
     def layout(self) -> Layout:
         """The study folder's files and runs table."""
         columns = {**{p.key: "REAL NOT NULL" for p in self.spec.parameters}, **{o: "REAL" for o in self.spec.outputs}}
+        if self.model_name == "scenario":
+            columns[WARNINGS_COLUMN] = "TEXT"  # the failed health checks of a run (JSON list)
         return Layout("design study", FORMAT, STUDY_FILE, {"run_index": "INTEGER"}, columns)
 
     def configuration(self) -> dict[str, Any]:
@@ -186,7 +198,9 @@ class Study:
 
     def _row(self, run_index: int, outcome: Mapping[str, Any]) -> dict[str, Any]:
         outputs = outcome.get("outputs", {})
-        values = {o: _number(outputs.get(o)) for o in self.spec.outputs}
+        values: dict[str, Any] = {o: _number(outputs.get(o)) for o in self.spec.outputs}
+        if self.model_name == "scenario":
+            values[WARNINGS_COLUMN] = json.dumps(outcome["warnings"]) if "warnings" in outcome else None
         return {"run_index": run_index, "status": outcome["status"], "error": outcome.get("error"), **self.parameters(run_index), **values}
 
 

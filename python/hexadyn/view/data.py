@@ -155,7 +155,13 @@ class Run:
         n = self.t.size
         self.recorded_feet = np.column_stack([data[c] for c in FOOT_COLUMNS]).reshape(-1, LEGS, 3) if self.has_feet else None
         self.forces = np.column_stack([data[c] for c in FORCE_COLUMNS]).reshape(-1, LEGS, 3) if self.has_forces else np.zeros((n, LEGS, 3))
-        self.phases = np.column_stack([data[c] for c in PHASE_COLUMNS]).astype(np.int8) if self.has_phases else np.full((n, LEGS), -1, np.int8)
+        if self.has_phases:
+            try:
+                self.phases = vocabulary.phase_codes(np.column_stack([data[c] for c in PHASE_COLUMNS]), PHASE_COLUMNS, self.t)
+            except ValueError as exc:
+                raise ViewError(f"{self.folder / TIMESERIES_FILE}: {exc}") from None
+        else:
+            self.phases = np.full((n, LEGS), -1, np.int8)
         self.reference_xy = np.column_stack([data["X_ref"], data["Y_ref"]]) if self.has_reference else None
 
     def _present(self, columns: list[str]) -> bool:

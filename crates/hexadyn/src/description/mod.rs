@@ -29,6 +29,7 @@
 use std::path::Path;
 
 mod tables;
+mod extends;
 pub mod mjcf;
 pub mod urdf;
 mod hexapod_parameters;
@@ -55,9 +56,17 @@ pub const AMRU5_TOML: &str = include_str!("../../../../robots/amru5.toml");
 /// The shipped PhantomX Mark II description (`robots/phantomx/phantomx.toml`), embedded.
 pub const PHANTOMX_TOML: &str = include_str!("../../../../robots/phantomx/phantomx.toml");
 
+/// AMRU5 with low-ratio, backdrivable drives (`robots/amru5_backdrivable.toml`, issue 40's
+/// "AMRU5 bis"), embedded: it extends `amru5`.
+pub const AMRU5_BACKDRIVABLE_TOML: &str = include_str!("../../../../robots/amru5_backdrivable.toml");
+
 /// The robots a scenario names by `scenario.robot = "<name>"`: name, embedded text, the file it
 /// was embedded from (named in errors).
-pub const SHIPPED_ROBOTS: [(&str, &str, &str); 2] = [("amru5", AMRU5_TOML, AMRU5_ORIGIN), ("phantomx", PHANTOMX_TOML, "robots/phantomx/phantomx.toml")];
+pub const SHIPPED_ROBOTS: [(&str, &str, &str); 3] = [
+    ("amru5", AMRU5_TOML, AMRU5_ORIGIN),
+    ("phantomx", PHANTOMX_TOML, "robots/phantomx/phantomx.toml"),
+    ("amru5_backdrivable", AMRU5_BACKDRIVABLE_TOML, "robots/amru5_backdrivable.toml"),
+];
 
 /// Name used in error messages for the embedded file.
 const AMRU5_ORIGIN: &str = "robots/amru5.toml";
@@ -87,8 +96,14 @@ impl RobotDescription {
 
     /// Parses and validates a description; `origin_name` (a file name) is used in errors.
     #[allow(clippy::should_implement_trait)]
+    ///
+    /// A description with `extends = "<shipped robot>"` is that robot's with the text's tables
+    /// merged over it (`extends.rs`, docs/robot-format.md).
     pub fn from_str(text: &str, origin_name: &str) -> Result<RobotDescription> {
         let index = SpanIndex::build_for(text, origin_name, PANTOGRAPH_REFERENCE)?;
+        if let Some((merged, base)) = extends::merged(text, &index)? {
+            return Self::from_str(&merged, origin_name).map_err(|e| extends::locate(e, &index, base));
+        }
         index.check_top_level(crate::fields::struct_fields::<RobotDescription>())?;
         let mut robot: RobotDescription = toml::from_str(text).map_err(|e| index.serde_error(&e))?;
         robot.origin = origin_name.to_string();

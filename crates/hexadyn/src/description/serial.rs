@@ -13,12 +13,12 @@ use std::collections::BTreeMap;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use serde::Deserialize;
 
-use super::tables::GroundTable;
+use super::tables::{ideal, GroundTable};
 use super::PiGains;
 use crate::control::{Encoder, FrictionFeedForward, PositionServo};
 use crate::fields::{Bound, Ctx, Finite, NonNegative, Positive, Result};
 use crate::hexapod::{JointKind, LegJoints, Link, Rotor, SerialHexapod, SerialJoint, SerialLeg, JOINTS, LEG_COUNT};
-use crate::physics::{DcMotor, DryViscous, FrictionElement, GroundContact, JointFriction, LuGre, SteadyState};
+use crate::physics::{DcMotor, DryViscous, Efficiency, FrictionElement, GroundContact, JointFriction, LuGre, SteadyState};
 use crate::robot::model::{FrictionModel, JointControl, ModelOptions, RobotParts};
 use crate::spatial::{yaw_pitch_roll, Htm};
 
@@ -101,6 +101,12 @@ pub struct FrictionSpec {
     pub sigma_1: f64,
     #[serde(deserialize_with = "Positive::checked")]
     pub v_d: f64,
+    /// Forward and backward efficiencies of the transmission (the efficiency law,
+    /// [`crate::physics::Efficiency`]), in (0, 1]; 1 (ideal) where left out.
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_forward: f64,
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_backward: f64,
 }
 
 /// A position servo's loop (the Dynamixel AX control table's compliance), and its position
@@ -511,12 +517,15 @@ impl SerialRobot {
     }
 }
 
-/// The friction element of a drive under the model's friction choice (Eq. 6.1 or Eq. 3.83-3.87
-/// with a dry steady state, as the rotation joints of Section 6.1).
+/// The friction element of a drive under the model's friction choice (Eq. 6.1, Eq. 3.83-3.87
+/// with a dry steady state, as the rotation joints of Section 6.1, or the efficiency law on the
+/// no-load friction of Eq. 6.1).
 fn friction_element(f: &FrictionSpec, model: FrictionModel) -> FrictionElement {
+    let dry_viscous = DryViscous { tau_f_d_plus: f.tau_f_d, tau_f_d_minus: -f.tau_f_d, f_v_plus: f.f_v, f_v_minus: f.f_v, epsilon: f.linear_zone };
     let law = match model {
         FrictionModel::None => JointFriction::None,
-        FrictionModel::DryViscous => JointFriction::DryViscous(DryViscous { tau_f_d_plus: f.tau_f_d, tau_f_d_minus: -f.tau_f_d, f_v_plus: f.f_v, f_v_minus: f.f_v, epsilon: f.linear_zone }),
+        FrictionModel::DryViscous => JointFriction::DryViscous(dry_viscous),
+        FrictionModel::Efficiency => JointFriction::Efficiency(Efficiency { eta_forward: f.eta_forward, eta_backward: f.eta_backward, no_load: dry_viscous }),
         FrictionModel::LuGre => JointFriction::LuGre(LuGre { sigma_0: f.sigma_0, sigma_1: f.sigma_1, v_d: f.v_d, f_v_plus: f.f_v, f_v_minus: f.f_v, steady: SteadyState::Dry { tau_f_d_plus: f.tau_f_d, tau_f_d_minus: -f.tau_f_d } }),
     };
     FrictionElement::new(law)

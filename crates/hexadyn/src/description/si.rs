@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
 use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
-use crate::physics::{DryViscous, LoadDependence};
+use crate::physics::{DryViscous, Efficiency, LoadDependence};
 
 impl MotorTable {
     /// L in H.
@@ -77,12 +77,21 @@ pub struct JointFrictionParameters {
     /// Load dependence of the dry friction (Table 5.5, Eq. 5.12; a_1^- after the
     /// `missing_a1_minus` rule): Some for q_h only.
     pub load_dependence: Option<LoadDependence>,
+    /// Forward and backward efficiencies of the transmission (`[friction.efficiency]`).
+    pub eta_forward: f64,
+    pub eta_backward: f64,
 }
 
 impl JointFrictionParameters {
     /// The dry/viscous law of Eq. 6.1 with these parameters (unloaded dry friction).
     pub fn dry_viscous(&self) -> DryViscous {
         DryViscous { tau_f_d_plus: self.tau_f_d_plus, tau_f_d_minus: self.tau_f_d_minus, f_v_plus: self.f_v_plus, f_v_minus: self.f_v_minus, epsilon: self.epsilon }
+    }
+
+    /// The efficiency law with these efficiencies on the no-load friction of Eq. 6.1 (the
+    /// unloaded dry and viscous friction of Table 5.3).
+    pub fn efficiency(&self) -> Efficiency {
+        Efficiency { eta_forward: self.eta_forward, eta_backward: self.eta_backward, no_load: self.dry_viscous() }
     }
 
     /// Dry friction under a foot load of `load_kg` (Eq. 5.12 with a_0 the unloaded dry
@@ -201,9 +210,23 @@ impl RobotDescription {
             .map(|s| (s.tau_f_s_plus_n.mu[leg].value(), s.tau_f_s_minus_n.mu[leg].value()))
     }
 
+    /// n/n_0: this robot's reduction of `joint` over the one its friction was identified
+    /// with (`friction.identified_with_reductions`), 1 when they are the same drives. The
+    /// dry friction of [`Self::friction`] scales by it, the viscous coefficients by its square.
+    pub fn friction_reduction_ratio(&self, joint: PantographJoint) -> f64 {
+        let Some(n_0) = &self.friction.identified_with_reductions else { return 1.0 };
+        let identified = match joint {
+            PantographJoint::Rotation => n_0.n_r,
+            PantographJoint::Vertical => n_0.n_v_rad_per_m,
+            PantographJoint::Horizontal => n_0.n_h_rad_per_m,
+        };
+        self.reduction(joint) / identified
+    }
+
     /// Friction parameters of one joint of one leg in joint units, with the Section 6.1
     /// rules applied (negative viscous -> 0, missing stiction -> unloaded dry, vertical
-    /// stiction of the `vertical_stiction_load_kg` case, a_0 of Eq. 5.12 = unloaded dry).
+    /// stiction of the `vertical_stiction_load_kg` case, a_0 of Eq. 5.12 = unloaded dry),
+    /// referred to this robot's reductions ([`Self::friction_reduction_ratio`]).
     ///
     /// # Panics
     /// If `leg` is not 0..5.
@@ -245,17 +268,26 @@ impl RobotDescription {
                 a_1_minus,
             }
         });
+        let efficiency = match joint {
+            PantographJoint::Rotation => f.efficiency.q_r,
+            PantographJoint::Vertical => f.efficiency.q_v,
+            PantographJoint::Horizontal => f.efficiency.q_h,
+        };
+        // Dry (and load) friction by n/n_0, viscous by (n/n_0)^2: 1 on the identified drives.
+        let ratio = self.friction_reduction_ratio(joint);
+        let (dry, viscous_ratio) = (|v: f64| v * ratio, ratio * ratio);
+        let load_dependence = load_dependence.map(|a| LoadDependence { a_2_plus: dry(a.a_2_plus), a_2_minus: dry(a.a_2_minus), a_1_plus: dry(a.a_1_plus), a_1_minus: dry(a.a_1_minus) });
         JointFrictionParameters {
             leg,
             joint,
-            tau_f_d_plus,
-            tau_f_d_minus,
-            tau_f_s_plus,
-            tau_f_s_minus,
-            f_v_plus: viscous(vp.mu[leg]),
-            f_v_minus: viscous(vm.mu[leg]),
-            f_v_plus_measured: vp.mu[leg],
-            f_v_minus_measured: vm.mu[leg],
+            tau_f_d_plus: dry(tau_f_d_plus),
+            tau_f_d_minus: dry(tau_f_d_minus),
+            tau_f_s_plus: dry(tau_f_s_plus),
+            tau_f_s_minus: dry(tau_f_s_minus),
+            f_v_plus: viscous(vp.mu[leg]) * viscous_ratio,
+            f_v_minus: viscous(vm.mu[leg]) * viscous_ratio,
+            f_v_plus_measured: vp.mu[leg] * viscous_ratio,
+            f_v_minus_measured: vm.mu[leg] * viscous_ratio,
             q_st: (joint == PantographJoint::Vertical).then_some(f.lugre.q_st_v_m_per_s),
             sigma_0: f.lugre.sigma_0,
             sigma_1: f.lugre.sigma_1,
@@ -263,6 +295,8 @@ impl RobotDescription {
             delta_d: f.lugre.delta_d,
             epsilon: f.lugre.dry_viscous_epsilon,
             load_dependence,
+            eta_forward: efficiency.eta_forward,
+            eta_backward: efficiency.eta_backward,
         }
     }
 }

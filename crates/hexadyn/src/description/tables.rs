@@ -495,10 +495,76 @@ pub struct FrictionTable {
     /// `friction.q_v.stiction` loads.
     pub vertical_stiction_load_kg: f64,
     pub missing_a1_minus: MissingA1MinusRule,
+    /// The reductions of the drives the friction tables were identified on, when they are not
+    /// this robot's (`[reductions]`): a drive variant of AMRU5 with other gear ratios (absent
+    /// on AMRU5 itself). See [`IdentifiedReductionsTable`].
+    #[serde(default)]
+    pub identified_with_reductions: Option<IdentifiedReductionsTable>,
     pub lugre: LuGreTable,
+    /// The transmission efficiencies of the efficiency law (`friction = "efficiency"`); ideal
+    /// transmissions (Eq. 6.1 alone) where left out.
+    #[serde(default)]
+    pub efficiency: EfficiencyTable,
     pub q_r: RotationalFrictionTable,
     pub q_v: VerticalFrictionTable,
     pub q_h: HorizontalFrictionTable,
+}
+
+/// `[friction.efficiency]`: the forward and backward efficiencies of each joint kind's
+/// transmission, every leg alike ([`crate::physics::Efficiency`]; the no-load friction is the
+/// joint's Table 5.3 dry/viscous friction).
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EfficiencyTable {
+    #[serde(default)]
+    pub q_r: TransmissionEfficiency,
+    #[serde(default)]
+    pub q_v: TransmissionEfficiency,
+    #[serde(default)]
+    pub q_h: TransmissionEfficiency,
+}
+
+/// The two efficiencies of a transmission, each in (0, 1]; 1 (ideal) where left out.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TransmissionEfficiency {
+    /// η_f: the motor drives the load.
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_forward: f64,
+    /// η_b: the load drives the motor.
+    #[serde(default = "ideal", deserialize_with = "Fraction::checked")]
+    pub eta_backward: f64,
+}
+
+impl Default for TransmissionEfficiency {
+    fn default() -> Self {
+        TransmissionEfficiency { eta_forward: ideal(), eta_backward: ideal() }
+    }
+}
+
+/// The efficiency of a lossless transmission.
+pub(super) fn ideal() -> f64 {
+    1.0
+}
+
+/// `[friction.identified_with_reductions]`: the global reductions n_0 of the drives the
+/// friction of Tables 5.3-5.5 was measured on. The friction is then taken as a torque at the
+/// motor shaft (the motor and the gear train, reflected to the joint through n_0) and brought
+/// to the joint through this robot's reductions n: the dry friction, the breakaway and the
+/// load coefficients scale by n/n_0, the viscous coefficients (a viscous torque at the motor,
+/// n_0 b n_0 q') by (n/n_0)^2; the LuGre bristle parameters are kept.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct IdentifiedReductionsTable {
+    /// n_0 of q_r (rad/rad).
+    #[serde(deserialize_with = "Positive::checked")]
+    pub n_r: f64,
+    /// n_0 of q_v (rad/m).
+    #[serde(deserialize_with = "Positive::checked")]
+    pub n_v_rad_per_m: f64,
+    /// n_0 of q_h (rad/m).
+    #[serde(deserialize_with = "Positive::checked")]
+    pub n_h_rad_per_m: f64,
 }
 
 /// `[friction.lugre]`: LuGre parameters, Table 6.1, Eqs. 3.84 and 6.1 (same numbers for the

@@ -279,3 +279,64 @@ fn missing_top_level_table() {
     let (e, s) = field_error(&text);
     assert_eq!(e.field(), Some("ground"), "{s}");
 }
+
+/// The backdrivable drives (`robots/amru5_backdrivable.toml`): AMRU5 with its drive tables
+/// changed, every other table the base's; the same peak joint torque and torque-speed line; the
+/// friction referred to a quarter of the ratio (dry x 1/4, viscous x 1/16).
+#[test]
+fn backdrivable_drives_extend_amru5() {
+    let base = amru5();
+    let bis = RobotDescription::from_str(AMRU5_BACKDRIVABLE_TOML, "robots/amru5_backdrivable.toml").expect("shipped description loads");
+    assert_eq!(bis.name, "AMRU5 backdrivable");
+    assert_eq!((&bis.geometry, &bis.ground, &bis.controller, &bis.joint_ranges, &bis.legs), (&base.geometry, &base.ground, &base.controller, &base.joint_ranges, &base.legs));
+    assert_eq!(bis.motor.resistance_ohm, base.motor.resistance_ohm);
+    for joint in PantographJoint::ALL {
+        let ratio = bis.reduction(joint) / base.reduction(joint);
+        assert_relative_eq!(ratio, 0.25, max_relative = 1e-3);
+        assert_eq!(bis.friction_reduction_ratio(joint), ratio);
+        assert_eq!(base.friction_reduction_ratio(joint), 1.0);
+        // Stall force at the supply behind the H-bridge, and k_t n.
+        let stall = |d: &RobotDescription| d.joint_torque_per_ampere(joint) * d.driver.supply_voltage_v / d.circuit_resistance_ohm();
+        assert_relative_eq!(stall(&bis), stall(&base), max_relative = 1e-3);
+        // The reflected rotor inertia J n^2.
+        let reflected = |d: &RobotDescription| d.inertia.rotor.i_axial_kg_m2 * d.reduction(joint).powi(2);
+        assert_relative_eq!(reflected(&bis), reflected(&base), max_relative = 2e-3);
+        for leg in 0..6 {
+            let (f, f0) = (bis.friction(leg, joint), base.friction(leg, joint));
+            assert_eq!((f.tau_f_d_plus, f.tau_f_s_minus), (f0.tau_f_d_plus * ratio, f0.tau_f_s_minus * ratio));
+            assert_eq!((f.f_v_plus, f.f_v_minus), (f0.f_v_plus * (ratio * ratio), f0.f_v_minus * (ratio * ratio)));
+            assert_eq!((f.sigma_0, f.sigma_1), (f0.sigma_0, f0.sigma_1));
+            if let (Some(a), Some(a0)) = (f.load_dependence, f0.load_dependence) {
+                assert_eq!((a.a_2_plus, a.a_1_plus), (a0.a_2_plus * ratio, a0.a_1_plus * ratio));
+            }
+        }
+    }
+    // Section 6.2: the sinking sense of q_v (q_v' < 0) breaks away below the standing load of a
+    // nut (m g, Eq. B.1's 6 x m g / 6) on the bis, above it on AMRU5.
+    let nut = base.total_mass_kg() * crate::mbs::STANDARD_GRAVITY;
+    for leg in 0..6 {
+        assert!(-base.friction(leg, PantographJoint::Vertical).tau_f_s_minus > nut, "AMRU5 leg {leg} holds");
+        assert!(-bis.friction(leg, PantographJoint::Vertical).tau_f_s_minus < nut / 1.9, "bis leg {leg} backdriven");
+    }
+}
+
+#[test]
+fn extends_errors_name_the_file_and_the_field() {
+    let bad = |text: &str| RobotDescription::from_str(text, "bis.toml").unwrap_err().to_string();
+    let s = bad("extends = \"phantomx\"\nname = \"x\"\n");
+    assert!(s.starts_with("bis.toml:1: field `extends` = \"phantomx\"") && s.contains("\"amru5\"") && !s.contains("\"phantomx\","), "{s}");
+    let s = bad("extends = 5\n");
+    assert!(s.starts_with("bis.toml:1: field `extends` = 5"), "{s}");
+    // A field of the file: its line.
+    let s = bad("extends = \"amru5\"\n\n[motor]\ntorque_constant_nm_per_a = -1.0\n");
+    assert!(s.starts_with("bis.toml:4: field `motor.torque_constant_nm_per_a` = -1") && s.contains("> 0"), "{s}");
+    let s = bad("extends = \"amru5\"\n[friction.identified_with_reductions]\nn_r = 0.0\nn_v_rad_per_m = 1.0\nn_h_rad_per_m = 1.0\n");
+    assert!(s.starts_with("bis.toml:3: field `friction.identified_with_reductions.n_r` = 0"), "{s}");
+    let s = bad("extends = \"amru5\"\nmass = 3\n");
+    assert!(s.starts_with("bis.toml:2: field `mass`") && s.contains("unknown"), "{s}");
+    // A check failing on a field of the base: no line, and said to be the base's.
+    let s = bad("extends = \"amru5\"\n[reductions]\nn_v_rad_per_m = 1000.0\n");
+    assert!(s.starts_with("bis.toml:3: field `reductions.n_v_rad_per_m` = 1000"), "{s}");
+    let s = bad("extends = \"amru5\"\n[reductions.components]\ngearbox_h = 1.0\n");
+    assert!(s.starts_with("bis.toml: field `reductions.n_h_rad_per_m`") && s.contains("base robot \"amru5\""), "{s}");
+}

@@ -18,9 +18,11 @@
 use std::fmt;
 
 mod bounded;
+mod csv_records;
 mod span_index;
 
 pub(crate) use bounded::{bounds, seq, Bound, Finite, NonNegative, Positive, Value, Violation};
+pub(crate) use csv_records::csv_records;
 pub(crate) use span_index::SpanIndex;
 
 /// The largest text input file read (scenario, robot description, heading and height CSV, link configuration):

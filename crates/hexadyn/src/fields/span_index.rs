@@ -55,6 +55,11 @@ impl<'t> SpanIndex<'t> {
         Ok(index)
     }
 
+    /// The file the index was built for (named in errors).
+    pub(crate) fn file(&self) -> &str {
+        &self.file
+    }
+
     fn walk_table(&mut self, table: &toml::de::DeTable<'_>, prefix: &str) {
         for (k, v) in table.iter() {
             let path = if prefix.is_empty() { k.get_ref().to_string() } else { format!("{prefix}.{}", k.get_ref()) };
@@ -96,6 +101,11 @@ impl<'t> SpanIndex<'t> {
             }
         }
         best.map(|(_, _, p, v)| (p, v))
+    }
+
+    /// Whether the document writes the field (or table, or array element) at `path` itself.
+    pub(crate) fn has(&self, path: &str) -> bool {
+        self.nodes.iter().any(|(p, ..)| p == path)
     }
 
     /// Line of the field at `path`, or of its closest enclosing table or array element that is

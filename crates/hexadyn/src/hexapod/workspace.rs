@@ -263,6 +263,16 @@ impl Workspace {
         Workspace { radius: self.radius - security, z_min: self.z_min + security, z_max: self.z_max - security, ..*self }
     }
 
+    /// The cylinder with its axis moved `offset` away from the leg's mount (towards it when
+    /// negative) along the horizontal direction of its centre, its radius reduced by |offset|
+    /// so that it stays inside this one; `None` when nothing is left (|offset| >= radius) or
+    /// the centre is on the mount's vertical (no direction).
+    pub fn moved_radially(&self, offset: f64) -> Option<Workspace> {
+        let distance = self.centre.norm();
+        let radius = self.radius - offset.abs();
+        (radius > 0.0 && distance > 0.0).then(|| Workspace { centre: self.centre * ((distance + offset) / distance), radius, ..*self })
+    }
+
     /// Kinematic margin (Section 7.7.3, [MCGH79, LEE88]): the distance the foot at p can still
     /// travel along `direction` (leg frame; the motion of the foot relative to the leg, i.e.
     /// opposite to the body's in support) before it leaves the cylinder. Zero on the boundary
@@ -316,6 +326,31 @@ mod tests {
     use crate::test_util::rng;
     use rand::Rng;
     use approx::assert_relative_eq;
+
+    /// A cylinder moved radially (`gait.foothold_offset_m`) lies inside the original and
+    /// touches it on the side it moved to: its axis `offset` further from the mount along the
+    /// centre's direction, its radius |offset| smaller; nothing is left at |offset| >= radius.
+    #[test]
+    fn moved_radially_stays_inside_and_touches() {
+        let w = neutral_workspace(&amru5()[0]);
+        for offset in [-0.03, -1e-3, 0.0, 1e-3, 0.03, 0.9 * w.radius] {
+            let m = w.moved_radially(offset).unwrap();
+            assert_relative_eq!(m.centre.norm(), w.centre.norm() + offset, epsilon = 1e-15);
+            assert_relative_eq!(m.centre.normalize(), w.centre.normalize(), epsilon = 1e-15);
+            assert_eq!((m.radius, m.z_min, m.z_max), (w.radius - offset.abs(), w.z_min, w.z_max));
+            let mut widest: f64 = 0.0;
+            for ia in 0..3600 {
+                let a = (ia as f64 / 10.0).to_radians();
+                let p = m.centre_at(w.z_min) + Vector3::new(a.cos(), a.sin(), 0.0) * m.radius;
+                assert!(w.contains(&p, 1e-12), "offset {offset}: {p} outside");
+                widest = widest.max((p.xy() - w.centre).norm());
+            }
+            assert_relative_eq!(widest, w.radius, epsilon = 1e-9);
+        }
+        assert_eq!(w.moved_radially(0.0).unwrap(), w);
+        assert!(w.moved_radially(w.radius).is_none() && w.moved_radially(-w.radius).is_none());
+        assert!(Workspace { centre: Vector2::zeros(), ..w }.moved_radially(0.01).is_none());
+    }
 
     /// The workspace cylinder is reachable everywhere on its boundary (IK unclamped), the
     /// kinematic margin is zero there, and it is the largest: 0.1 mm wider is not reachable.

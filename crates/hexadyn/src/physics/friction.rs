@@ -344,12 +344,90 @@ impl LoadDependence {
     }
 }
 
-/// Friction law of one joint (Section 6.1: the three cases compared in Chapter 6).
+/// Transmission-efficiency friction of a joint's drive (the thesis' second prospect, Chapter 8:
+/// "efficiency of transmission naturally accounts for the load acting on it").
+///
+/// The standard form of a gearbox's or a screw's losses splits them into a no-load part, which
+/// the drive needs to move without any transmitted load (seals, bearings, lubricant, preload),
+/// and a load-dependent part, the mesh loss, a fraction of the power the transmission carries
+/// (ISO/TR 14179-1; Niemann & Winter, Maschinenelemente II, Ch. 22), whose efficiency depends on
+/// the direction of the power flow (for a screw of lead angle λ and friction angle φ, forward
+/// η_f = tan λ / tan(λ + φ) when the motor drives the load, backward η_b = tan(λ − φ) / tan λ
+/// when the load drives the motor; Modelica's `LossyGear` has the same two efficiencies).
+///
+/// Written at the joint, with τ_m = n k_t i the motor torque (Eq. 5.17) and N(q') the no-load
+/// friction (Eq. 6.1 with the unloaded dry and viscous parameters of Table 5.3, which are the
+/// motor torque of a joint moving without transmitted load, Eq. 5.3), the torque the
+/// transmission carries beyond the no-load friction is e = τ_m − N(q'). In steady motion the
+/// joint passes on the load torque τ_L = τ_m − τ_f:
+///
+/// - forward, e q' > 0 (the motor's torque beyond N is in the direction of motion):
+///   τ_L = η_f e, so τ_f = N + (1 − η_f) e;
+/// - backward, e q' < 0 (the load drives the motion against the motor): the motor receives
+///   e = η_b τ_L, so τ_f = N + (1 − 1/η_b) e.
+///
+/// Hence τ_f = N(q') + L(q', e) with L = (1 − η_f) e forward and (1 − 1/η_b) e backward; L has
+/// the sign of q' (|L| = (1 − η_f)|e| or (1/η_b − 1)|e|): the friction still opposes the motion
+/// and grows with the transmitted load, whatever its direction. With η_f = η_b = 1 the law is
+/// Eq. 6.1 itself; without transmitted load (e = 0) it is too, so the unloaded identification
+/// of Section 5.2 reads the same parameters.
+///
+/// Non-smooth points: the power-flow direction sgn(e q') switches (1) with the direction of
+/// motion at q' = 0, where L jumps between its forward and backward value (the discontinuity
+/// of a dry friction's sign), and (2) with e at e = 0, where L is continuous (zero) with a kink.
+/// (1) is regularised as the dry friction's sign is: L is added to the dry friction τ_f,d^± of
+/// the direction of q' and the sum goes through the linear zone of Eq. 6.1
+/// ([`DryViscous::torque_with_dry`], as the load-dependent dry friction of Eq. 5.12 does), so
+/// that τ_f is continuous and zero at q' = 0. (2) is a kink like |q'| in the LuGre laws: the
+/// partial derivative there is the forward branch's (e = 0 belongs to the forward branch).
+///
+/// Partial derivatives (for the implicit Newmark Jacobian; τ_m depends on the current, itself a
+/// state or, without inductance, a function of q' and of the voltage through Eq. 4.4): with
+/// (T, ∂T/∂q', ∂T/∂τ_d) of the linear zone at τ_d = τ_f,d^± + L and L' = ∂L/∂e,
+/// ∂τ_f/∂τ_m = ∂T/∂τ_d L' and ∂τ_f/∂q' = ∂T/∂q' − ∂T/∂τ_d L' ∂N/∂q'.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Efficiency {
+    /// η_f in (0, 1]: the motor drives the load.
+    pub eta_forward: f64,
+    /// η_b in (0, 1]: the load drives the motor (backdrivable transmission; a self-locking one
+    /// would have η_b ≤ 0, outside this law).
+    pub eta_backward: f64,
+    /// The no-load friction N(q') of Eq. 6.1.
+    pub no_load: DryViscous,
+}
+
+impl Efficiency {
+    pub fn validate(&self) -> Result<(), FrictionError> {
+        require("eta_forward", self.eta_forward, self.eta_forward > 0.0 && self.eta_forward <= 1.0, "0 < eta <= 1")?;
+        require("eta_backward", self.eta_backward, self.eta_backward > 0.0 && self.eta_backward <= 1.0, "0 < eta <= 1")?;
+        self.no_load.validate()
+    }
+
+    /// The load-dependent loss L(q', e) of the direction of q' and ∂L/∂e for the transmitted
+    /// torque e = τ_m − N(q'): forward when e has the direction's sign (or is zero).
+    fn loss(&self, qd: f64, e: f64) -> (f64, f64) {
+        let forward = if positive(qd) { e >= 0.0 } else { e <= 0.0 };
+        let slope = if forward { 1.0 - self.eta_forward } else { 1.0 - 1.0 / self.eta_backward };
+        (slope * e, slope)
+    }
+
+    /// τ_f(q', τ_m) with ∂τ_f/∂q' and ∂τ_f/∂τ_m (see the type's doc).
+    pub fn torque(&self, qd: f64, tau_m: f64) -> (f64, f64, f64) {
+        let (n, dn_dqd) = self.no_load.torque(qd);
+        let (l, dl_de) = self.loss(qd, tau_m - n);
+        let (tau, dtau_dqd, dtau_dtau_d) = self.no_load.torque_with_dry(qd, self.no_load.dry(qd) + l);
+        (tau, dtau_dqd - dtau_dtau_d * dl_de * dn_dqd, dtau_dtau_d * dl_de)
+    }
+}
+
+/// Friction law of one joint (Section 6.1: the three cases compared in Chapter 6; the
+/// transmission efficiency of the thesis' prospects, Chapter 8).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum JointFriction {
     None,
     DryViscous(DryViscous),
     LuGre(LuGre),
+    Efficiency(Efficiency),
 }
 
 impl JointFriction {
@@ -363,6 +441,7 @@ impl JointFriction {
             JointFriction::None => Ok(()),
             JointFriction::DryViscous(law) => law.validate(),
             JointFriction::LuGre(law) => law.validate(),
+            JointFriction::Efficiency(law) => law.validate(),
         }
     }
 }
@@ -379,6 +458,9 @@ pub struct FrictionTorque {
     pub dtau_dzdot: f64,
     /// With respect to the foot load in N (zero without load dependence).
     pub dtau_dload: f64,
+    /// With respect to the motor torque τ_m = n k_t i at the joint (zero but for the
+    /// efficiency law).
+    pub dtau_dtau_m: f64,
 }
 
 /// Bristle residual row (Eq. 3.85) of a [`FrictionElement`] and its partial derivatives.
@@ -428,22 +510,29 @@ impl FrictionElement {
             JointFriction::None => return (0.0, 0.0),
             JointFriction::DryViscous(law) => law.dry(qd),
             JointFriction::LuGre(law) => law.steady.dry(qd),
+            JointFriction::Efficiency(law) => law.no_load.dry(qd),
         };
         self.load.map_or((a0, 0.0), |l| l.dry_friction(a0, qd, load))
     }
 
-    /// Friction torque τ_f(q', z, z', load) with its partials: Eq. 6.1 (z, z' ignored) or Eq. 3.87.
-    pub fn torque(&self, qd: f64, z: f64, zdot: f64, load: f64) -> FrictionTorque {
+    /// Friction torque τ_f(q', z, z', load, τ_m) with its partials: Eq. 6.1 (z, z', τ_m
+    /// ignored), Eq. 3.87 (τ_m ignored) or the efficiency law (z, z', load ignored), with τ_m
+    /// the motor torque at the joint.
+    pub fn torque(&self, qd: f64, z: f64, zdot: f64, load: f64, tau_m: f64) -> FrictionTorque {
         match &self.law {
             JointFriction::None => FrictionTorque::default(),
             JointFriction::DryViscous(law) => {
                 let (tau_d, dtau_d_dload) = self.dry_friction(qd, load);
                 let (tau, dtau_dqd, dtau_dtau_d) = law.torque_with_dry(qd, tau_d);
-                FrictionTorque { tau, dtau_dqd, dtau_dz: 0.0, dtau_dzdot: 0.0, dtau_dload: dtau_dtau_d * dtau_d_dload }
+                FrictionTorque { tau, dtau_dqd, dtau_dload: dtau_dtau_d * dtau_d_dload, ..FrictionTorque::default() }
             }
             JointFriction::LuGre(law) => {
                 let (tau, dtau_dqd, dtau_dz, dtau_dzdot) = law.torque(qd, z, zdot);
-                FrictionTorque { tau, dtau_dqd, dtau_dz, dtau_dzdot, dtau_dload: 0.0 }
+                FrictionTorque { tau, dtau_dqd, dtau_dz, dtau_dzdot, ..FrictionTorque::default() }
+            }
+            JointFriction::Efficiency(law) => {
+                let (tau, dtau_dqd, dtau_dtau_m) = law.torque(qd, tau_m);
+                FrictionTorque { tau, dtau_dqd, dtau_dtau_m, ..FrictionTorque::default() }
             }
         }
     }
@@ -533,9 +622,9 @@ mod tests {
 
             let element = FrictionElement::new(JointFriction::DryViscous(law)).with_load(horizontal_leg0_load());
             let load = r.random_range(1.0..200.0);
-            let t = element.torque(qd, 0.0, 0.0, load);
-            assert_partial("dτ/dq' (loaded)", t.dtau_dqd, central(|x| element.torque(x, 0.0, 0.0, load).tau, qd, h), 1e-6, noise(t.tau, h));
-            assert_partial("dτ/dload", t.dtau_dload, central(|x| element.torque(qd, 0.0, 0.0, x).tau, load, 1e-2), 1e-6, noise(t.tau, 1e-2));
+            let t = element.torque(qd, 0.0, 0.0, load, 0.0);
+            assert_partial("dτ/dq' (loaded)", t.dtau_dqd, central(|x| element.torque(x, 0.0, 0.0, load, 0.0).tau, qd, h), 1e-6, noise(t.tau, h));
+            assert_partial("dτ/dload", t.dtau_dload, central(|x| element.torque(qd, 0.0, 0.0, x, 0.0).tau, load, 1e-2), 1e-6, noise(t.tau, 1e-2));
         }
     }
 
@@ -602,7 +691,7 @@ mod tests {
             let fe = |qd: f64, load: f64| element.bristle_residual(qd, z, zdot, load).unwrap().f;
             assert_partial("∂f_z/∂q' (loaded)", b.df_dqd, central(|x| fe(x, load), qd, h), 1e-6, nf(h));
             assert_partial("∂f_z/∂load", b.df_dload, central(|x| fe(qd, x), load, 1e-4), 1e-6, nf(1e-4));
-            let t = element.torque(qd, z, zdot, load);
+            let t = element.torque(qd, z, zdot, load, 0.0);
             assert_eq!((t.tau, t.dtau_dqd, t.dtau_dz, t.dtau_dzdot, t.dtau_dload), (law.torque(qd, z, zdot).0, dtau_dqd, dtau_dz, dtau_dzdot, 0.0));
         }
     }
@@ -687,7 +776,74 @@ mod tests {
             assert_partial("dτ̃_d/dload", d, central(|l| load.dry_friction(a0, qd, l).0, x, 1e-2), 1e-6, noise(value, 1e-2));
         }
         let element = FrictionElement::new(JointFriction::DryViscous(DryViscous::new(465.1, -563.1, 0.0, 0.0).unwrap())).with_load(load);
-        assert!((element.torque(1e-3, 0.0, 0.0, ten_kg).tau - element.dry_friction(1e-3, ten_kg).0).abs() < 1e-9);
+        assert!((element.torque(1e-3, 0.0, 0.0, ten_kg, 0.0).tau - element.dry_friction(1e-3, ten_kg).0).abs() < 1e-9);
+    }
+
+    fn random_efficiency(r: &mut impl Rng) -> Efficiency {
+        Efficiency { eta_forward: r.random_range(0.3..1.0), eta_backward: r.random_range(0.3..1.0), no_load: random_dry_viscous(r) }
+    }
+
+    #[test]
+    fn efficiency_partials_match_finite_differences() {
+        let mut r = rng(5);
+        for k in 0..800 {
+            let law = random_efficiency(&mut r);
+            let eps = law.no_load.epsilon;
+            let qd = if k % 2 == 0 { velocity(&mut r, 0.05 * eps, 0.95 * eps) } else { velocity(&mut r, 1.05 * eps, 1e3 * eps) };
+            // A transmitted torque e = τ_m − N of either sign, away from the kink at e = 0.
+            let e = velocity(&mut r, 10.0, 2000.0);
+            let tau_m = law.no_load.torque(qd).0 + e;
+            let (h, h_m) = (1e-4 * qd.abs(), 1e-4 * e.abs());
+            let (tau, dtau_dqd, dtau_dtau_m) = law.torque(qd, tau_m);
+            assert_partial("∂τ/∂q'", dtau_dqd, central(|x| law.torque(x, tau_m).0, qd, h), 1e-6, noise(tau.abs() + tau_m.abs(), h));
+            assert_partial("∂τ/∂τ_m", dtau_dtau_m, central(|x| law.torque(qd, x).0, tau_m, h_m), 1e-6, noise(tau.abs() + tau_m.abs(), h_m));
+            let element = FrictionElement::new(JointFriction::Efficiency(law));
+            let t = element.torque(qd, 0.0, 0.0, 100.0, tau_m);
+            assert_eq!((t.tau, t.dtau_dqd, t.dtau_dtau_m, t.dtau_dload, t.dtau_dz), (tau, dtau_dqd, dtau_dtau_m, 0.0, 0.0));
+        }
+    }
+
+    /// On the kink e = 0 the partial with respect to τ_m is the forward branch's, in both
+    /// directions of motion.
+    #[test]
+    fn efficiency_kink_belongs_to_the_forward_branch() {
+        let law = Efficiency { eta_forward: 0.65, eta_backward: 0.5, no_load: DryViscous::new(335.1, -423.6, 3763.0, 8005.8).unwrap() };
+        for qd in [1e-3, -1e-3] {
+            let tau_m = law.no_load.torque(qd).0;
+            let (tau, _, dtau_dtau_m) = law.torque(qd, tau_m);
+            let h = 1e-3 * qd.signum();
+            assert_partial("forward one-sided ∂τ/∂τ_m", dtau_dtau_m, (law.torque(qd, tau_m + h).0 - tau) / h, 1e-9, noise(tau, h.abs()));
+            assert!((dtau_dtau_m - 0.35).abs() < 1e-12);
+        }
+    }
+
+    /// Steady motion: the joint passes on η_f e forward and e / η_b backward; the friction
+    /// opposes the motion, vanishes at rest and is Eq. 6.1 without transmitted load or with
+    /// ideal efficiencies (bit for bit).
+    #[test]
+    fn efficiency_law_transmits_eta_times_the_power() {
+        let no_load = DryViscous::new(335.1, -423.6, 3763.0, 8005.8).unwrap();
+        let law = Efficiency { eta_forward: 0.65, eta_backward: 0.5, no_load };
+        let ideal = Efficiency { eta_forward: 1.0, eta_backward: 1.0, no_load };
+        let mut r = rng(6);
+        for _ in 0..2000 {
+            let qd = velocity(&mut r, 1e-8, 1.0);
+            let tau_m = r.random_range(-3000.0..3000.0);
+            assert_eq!(ideal.torque(qd, tau_m).0.to_bits(), no_load.torque(qd).0.to_bits());
+            let n = no_load.torque(qd).0;
+            assert_eq!(law.torque(qd, n).0, n, "no transmitted load at q' = {qd}");
+            let tau = law.torque(qd, tau_m).0;
+            assert!(tau * qd > 0.0, "friction must oppose the motion at q' = {qd}, τ_m = {tau_m}");
+            if qd.abs() > no_load.epsilon {
+                let (e, load) = (tau_m - n, tau_m - tau);
+                let expected = if e * qd >= 0.0 { 0.65 * e } else { e / 0.5 };
+                assert!((load - expected).abs() < 1e-9 * (1.0 + e.abs()), "q' = {qd}, e = {e}: τ_L = {load}, expected {expected}");
+            }
+        }
+        assert_eq!(law.torque(0.0, 500.0).0, 0.0);
+        for (eta_forward, eta_backward) in [(0.0, 0.5), (1.2, 0.5), (0.6, -0.1), (0.6, f64::NAN)] {
+            assert!(Efficiency { eta_forward, eta_backward, no_load }.validate().is_err(), "{eta_forward}, {eta_backward}");
+        }
     }
 
     #[test]
@@ -697,6 +853,6 @@ mod tests {
         let none = FrictionElement::new(JointFriction::None);
         assert!(!dry.has_bristle_state() && !none.has_bristle_state() && lugre.has_bristle_state());
         assert!(dry.bristle_residual(1e-3, 0.0, 0.0, 0.0).is_none());
-        assert_eq!(none.torque(1.0, 1.0, 1.0, 1.0), FrictionTorque::default());
+        assert_eq!(none.torque(1.0, 1.0, 1.0, 1.0, 1.0), FrictionTorque::default());
     }
 }

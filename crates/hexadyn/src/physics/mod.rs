@@ -15,7 +15,7 @@ pub use contact::{ContactForce, GroundContact};
 pub use terrain::{Extent, FlatGround, Heightfield, MeshTerrain, Proximity, Slope, Step, Terrain, Triangles, Vicinity};
 pub use current_sensor::{AnalogLowPass, CurrentSensing, CurrentSensors, ANALOG_CURRENT_CUTOFF_HZ};
 pub use friction::{
-    BristleResidual, DryViscous, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,
+    BristleResidual, DryViscous, Efficiency, FrictionElement, FrictionError, FrictionTorque, JointFriction, LoadDependence, LuGre, SteadyState,
     LOAD_GRAVITY,
 };
 pub use motor::{limit_switch, saturate, Current, CurrentResidual, DcMotor};

@@ -1,6 +1,6 @@
 //! The complete robot model as one residual system (thesis Section 3.5, Fig. 3.16, Table 3.5):
 //! the 24-DOF multibody mechanics, ground contact at the six feet, joint friction (none,
-//! dry/viscous or LuGre with its 18 bristle states) and the 18 DC motors with their H-bridge
+//! dry/viscous, LuGre with its 18 bristle states, or transmission efficiency) and the 18 DC motors with their H-bridge
 //! (inductance neglected, Eq. 4.4, or kept as 18 current states, Eq. 3.91).
 //!
 //! Rows and coordinates: q (24, Eq. 3.51), then the bristle states z = q'_z (Eq. 3.85), then the
@@ -50,15 +50,20 @@ pub enum FrictionModel {
     /// `"lugre"`: the LuGre model with one bristle state per joint (Eq. 3.83-3.87).
     #[serde(rename = "lugre")]
     LuGre,
+    /// `"efficiency"`: the no-load friction of Eq. 6.1 plus a loss that follows the torque the
+    /// transmission carries, with a forward and a backward efficiency
+    /// ([`crate::physics::Efficiency`]).
+    Efficiency,
 }
 
 impl FrictionModel {
-    /// The name used in scenario files: `none`, `dry_viscous` or `lugre`.
+    /// The name used in scenario files: `none`, `dry_viscous`, `lugre` or `efficiency`.
     pub fn name(self) -> &'static str {
         match self {
             FrictionModel::None => "none",
             FrictionModel::DryViscous => "dry_viscous",
             FrictionModel::LuGre => "lugre",
+            FrictionModel::Efficiency => "efficiency",
         }
     }
 }
@@ -419,7 +424,7 @@ impl Robot {
             out.voltage[k] = u;
             out.current[k] = i;
             out.motor_torque[k] = motor.joint_torque(i).0;
-            out.friction_torque[k] = m.friction[k].torque(qd[j], z, zdot, load).tau;
+            out.friction_torque[k] = m.friction[k].torque(qd[j], z, zdot, load, out.motor_torque[k]).tau;
             out.bristle[k] = z;
         }
     }
@@ -475,7 +480,7 @@ impl Robot {
             let j = 6 + k;
             let load = self.outputs.contact[k / 3].normal_force;
             if let Some(b) = m.bristles {
-                mass[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load).dtau_dzdot;
+                mass[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load, self.outputs.motor_torque[k]).dtau_dzdot;
                 mass[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dzdot;
             }
             if let Some(c) = m.currents {
@@ -569,17 +574,19 @@ impl System for Robot {
             let leg = k / 3;
             let load = self.outputs.contact[leg].normal_force;
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
-            // f_j contains −τ_m + τ_f.
-            let t = m.friction[k].torque(qd[j], z, zdot, load);
+            // f_j contains −τ_m + τ_f(τ_m): a change of τ_m enters with the factor
+            // −(1 − ∂τ_f/∂τ_m) (exactly −1 but for the efficiency law).
+            let t = m.friction[k].torque(qd[j], z, zdot, load, self.outputs.motor_torque[k]);
+            let passed = 1.0 - t.dtau_dtau_m;
             let motor = &m.motors[k];
             let dtau_m = if m.currents.is_some() { 0.0 } else { motor.joint_torque(motor.current(qd[j], 0.0).di_dqd).0 };
-            jac.ct[(j, j)] += t.dtau_dqd - dtau_m;
+            jac.ct[(j, j)] += t.dtau_dqd - passed * dtau_m;
             if let Some(servos) = &m.servos {
                 // The servo's voltage u(q_d − q_j) drives the motor (f_j contains −τ_m(u)).
                 let du_dq = servos[k].voltage(self.references[k], q[j], m.options.supply_voltage).du_dq;
                 match m.currents {
                     Some(c) => jac.kt[(c + k, j)] = -du_dq,
-                    None => jac.kt[(j, j)] -= motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * du_dq,
+                    None => jac.kt[(j, j)] -= passed * motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * du_dq,
                 }
             }
             for col in 0..DOF {
@@ -607,15 +614,18 @@ impl System for Robot {
         for k in 0..JOINTS {
             let j = 6 + k;
             let load = self.outputs.contact[k / 3].normal_force;
+            let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
+            let t = m.friction[k].torque(qd[j], z, zdot, load, self.outputs.motor_torque[k]);
+            let passed = 1.0 - t.dtau_dtau_m;
             if let Some(b) = m.bristles {
                 // f_j contains +τ_f (the joint force is τ_m − τ_f).
-                jac.ct[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load).dtau_dz;
+                jac.ct[(j, b + k)] = t.dtau_dz;
                 jac.ct[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dz;
             }
             if let Some(c) = m.currents {
                 jac.ct[(c + k, c + k)] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).df_di;
-                // f_j contains −τ_m = −n k_t i.
-                jac.ct[(j, c + k)] = -m.motors[k].joint_torque(1.0).1;
+                // f_j contains −τ_m + τ_f(τ_m), τ_m = n k_t i.
+                jac.ct[(j, c + k)] = -passed * m.motors[k].joint_torque(1.0).1;
             }
             if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
                 let (u, i) = (p + 2 * k, p + 2 * k + 1);
@@ -630,7 +640,7 @@ impl System for Robot {
                     Some(c) => jac.ct[(c + k, u)] = -passes,
                     None => {
                         let motor = &m.motors[k];
-                        jac.ct[(j, u)] = -motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * passes;
+                        jac.ct[(j, u)] = -passed * motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * passes;
                     }
                 }
             }
@@ -667,7 +677,8 @@ impl System for Robot {
         }
     }
 
-    /// The inputs enter only the rows of their own joint, affinely, at fixed (q, q', q''):
+    /// The inputs enter only the rows of their own joint, at fixed (q, q', q''), affinely but
+    /// for the efficiency law's friction, which follows the motor torque:
     /// a voltage (saturated at the supply; the limit switches were applied when it was
     /// commanded, [`Robot::command`]) through the current of Eq. 4.4 into the joint row
     /// (f_j contains −n k_t i) or, with inductance, into the current row of Eq. 3.91 (−u); a
@@ -690,13 +701,21 @@ impl System for Robot {
                 _ => {
                     let motor = &m.motors[k];
                     let supply = m.options.supply_voltage;
-                    let du = match &m.servos {
-                        Some(servos) => servos[k].voltage(self.references[k], q[j], supply).u - servos[k].voltage(previous[k], q[j], supply).u,
-                        None => saturate(self.voltages[k], supply) - saturate(previous[k], supply),
+                    let (u, before) = match &m.servos {
+                        Some(servos) => (servos[k].voltage(self.references[k], q[j], supply).u, servos[k].voltage(previous[k], q[j], supply).u),
+                        None => (saturate(self.voltages[k], supply), saturate(previous[k], supply)),
                     };
+                    let du = u - before;
                     match m.currents {
                         Some(c) => df[c + k] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], 0.0).df_du * du,
-                        None => df[j] = -motor.joint_torque(motor.current(qd[j], 0.0).di_du * du).0,
+                        None => {
+                            // f_j contains −τ_m + τ_f(τ_m): the friction's change is exactly
+                            // zero but for the efficiency law, whose loss follows τ_m.
+                            let dtau_m = motor.joint_torque(motor.current(qd[j], 0.0).di_du * du).0;
+                            let tau_m = motor.joint_torque(motor.current(qd[j], u).i).0;
+                            let friction = |tau_m: f64| m.friction[k].torque(qd[j], 0.0, 0.0, 0.0, tau_m).tau;
+                            df[j] = -dtau_m + (friction(tau_m) - friction(tau_m - dtau_m));
+                        }
                     }
                 }
             }

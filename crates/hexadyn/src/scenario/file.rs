@@ -277,7 +277,7 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
         (robot, shown, text)
     };
     let period = robot.period();
-    c.check(h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a duration >= {period} s (one control period)")).map_err(e)?;
+    c.check(h.duration_s.is_finite() && h.duration_s >= period, "scenario.duration_s", h.duration_s, &format!("a finite duration >= {period} s (one control period)")).map_err(e)?;
 
     // Model.
     let m = &raw.model;
@@ -291,6 +291,9 @@ pub(super) fn validate(raw: &RawScenario, c: &Ctx, text: &str, origin: &str, dir
     let mut model = robot.model_options(m.friction);
     if m.load_dependence && m.friction == FrictionModel::None {
         return Err(e(c.err("model.load_dependence", "true", "needs joint friction", "false with friction = \"none\" (or friction = \"dry_viscous\" or \"lugre\")")));
+    }
+    if m.load_dependence && m.friction == FrictionModel::Efficiency {
+        return Err(e(c.err("model.load_dependence", "true", "the efficiency law's loss already follows the transmitted load", "false with friction = \"efficiency\" (Eq. 5.12 goes with friction = \"dry_viscous\" or \"lugre\")")));
     }
     model.load_dependence = m.load_dependence;
     model.inductance = m.inductance;

@@ -86,6 +86,7 @@ pub(super) struct RawGait {
     #[serde(default)]
     friction_feedforward: bool,
     body_height_m: Option<f64>,
+    foothold_offset_m: Option<f64>,
     heading: RawHeading,
     #[serde(default)]
     change: Vec<RawChange>,
@@ -398,7 +399,10 @@ struct Stance {
 }
 
 /// The body height (`gait.body_height_m` or `default`) and the workspace of each leg for the
-/// foot heights from the ground to the clearance (Section 7.1.1).
+/// foot heights from the ground to the clearance (Section 7.1.1), moved radially by
+/// `gait.foothold_offset_m` (beyond the thesis, whose footholds centre on the largest
+/// cylinder's axis C, Eq. 7.24: the spread of the feet as a design parameter, the cylinder
+/// shrunk to stay within the reach).
 fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_text: &'static str, clearance: f64) -> Result<Stance> {
     let height = g.body_height_m.unwrap_or(default);
     let given = if g.body_height_m.is_some() { "" } else { default_text };
@@ -430,6 +434,14 @@ fn stance<L: Leg>(g: &RawGait, c: &Ctx, legs: &[L; 6], default: f64, default_tex
                 }
                 return Err(c.err("gait.clearance_m", clearance, &format!("no workspace: {e}"), format!("a clearance in (0, {ok:.4}) m at the body height {height:.4} m{given}")));
             }
+        }
+    }
+    if let Some(offset) = g.foothold_offset_m {
+        let smallest = workspaces.iter().map(|w| w.radius).fold(f64::INFINITY, f64::min);
+        let allowed = format!("a finite offset (m) of magnitude below {smallest:.4}, the smallest workspace radius at the body height {height:.4} m{given} and clearance {clearance} m");
+        c.check(offset.is_finite() && offset.abs() < smallest, "gait.foothold_offset_m", offset, &allowed)?;
+        for w in &mut workspaces {
+            *w = w.moved_radially(offset).ok_or_else(|| c.err("gait.foothold_offset_m", offset, "a leg whose workspace centre is on its mount's vertical", "no foothold offset with this robot"))?;
         }
     }
     Ok(Stance { height, workspaces: workspaces.try_into().expect("six legs"), given })
@@ -641,7 +653,7 @@ fn reject_periodic_fields(g: &RawGait, c: &Ctx) -> Result<()> {
     ];
     for (name, value) in written {
         if let Some(v) = value {
-            return Err(c.err(&format!("gait.{name}"), v, "not a field of pattern = \"free\"", "with the free gait: clearance_m, navigation, body_height_m, [gait.heading] and [gait.free] (takeoff_s, swing_s, posture_time_s, landing, landing_threshold_n, failed_leg, stability_margin_m, energy_margin_m, elevator)"));
+            return Err(c.err(&format!("gait.{name}"), v, "not a field of pattern = \"free\"", "with the free gait: clearance_m, navigation, body_height_m, foothold_offset_m, [gait.heading] and [gait.free] (takeoff_s, swing_s, posture_time_s, landing, landing_threshold_n, failed_leg, stability_margin_m, energy_margin_m, elevator)"));
         }
     }
     Ok(())

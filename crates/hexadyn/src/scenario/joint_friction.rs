@@ -3,16 +3,18 @@
 //! (Table 6.7), or a what-if study. One table per joint of a leg:
 //!
 //! - pantograph legs (AMRU5): `[model.joint_friction.q_r]`, `.q_v`, `.q_h`, the directional
-//!   parameters of Eq. 6.1 and the load coefficients of Eq. 5.12, replacing the per-leg
-//!   identification (Tables 5.3 and 5.5);
+//!   parameters of Eq. 6.1, the load coefficients of Eq. 5.12 and the transmission
+//!   efficiencies of the efficiency law, replacing the per-leg identification (Tables 5.3 and
+//!   5.5) and `[friction.efficiency]`;
 //! - serial legs: `[model.joint_friction.<joint name>]` (the robot's `[joints] names`), the
 //!   fields of its `[drives.<joint>.friction]` (the same in both senses), replacing them.
 //!
 //! The keys, units and signs are documented with the file format in `docs/scenario-format.md`.
 //!
 //! Keys left out keep the robot's values. The signs are those of a physical friction (a dry
-//! friction opposes the motion and grows with the load; a viscous slope is not negative), which
-//! is also the rejection rule of the Monte Carlo draws (Section 6.5, [`physical_bounds`]).
+//! friction opposes the motion and grows with the load; a viscous slope is not negative; an
+//! efficiency is in (0, 1]), which is also the rejection rule of the Monte Carlo draws (Section
+//! 6.5, [`physical_bounds`]).
 
 use std::collections::BTreeMap;
 
@@ -31,12 +33,14 @@ const TABLE: &str = "model.joint_friction";
 #[serde(transparent)]
 pub(super) struct RawJointFriction(BTreeMap<String, toml::Table>);
 
-/// The sign a physical value has.
+/// The sign (or range) a physical value has.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Sign {
     Positive,
     NonNegative,
     NonPositive,
+    /// An efficiency, in (0, 1].
+    Efficiency,
 }
 
 impl Sign {
@@ -45,6 +49,7 @@ impl Sign {
             Sign::Positive => v > 0.0,
             Sign::NonNegative => v >= 0.0,
             Sign::NonPositive => v <= 0.0,
+            Sign::Efficiency => v > 0.0 && v <= 1.0,
         }
     }
 
@@ -53,14 +58,16 @@ impl Sign {
             Sign::Positive => format!("a finite number > 0 ({what})"),
             Sign::NonNegative => format!("a finite number >= 0 ({what})"),
             Sign::NonPositive => format!("a finite number <= 0 ({what}, minus sense)"),
+            Sign::Efficiency => format!("a number in (0, 1] ({what})"),
         }
     }
 
-    /// The interval of the physical values.
+    /// The interval of the physical values (closed: an efficiency of exactly 0 is never drawn).
     fn interval(self) -> (f64, f64) {
         match self {
             Sign::Positive | Sign::NonNegative => (0.0, f64::INFINITY),
             Sign::NonPositive => (f64::NEG_INFINITY, 0.0),
+            Sign::Efficiency => (0.0, 1.0),
         }
     }
 }
@@ -83,6 +90,15 @@ impl Parameter {
         self.sign.allowed(&format!("{}, {}", self.what, kind.unit(self.units)))
     }
 }
+
+/// A dimensionless parameter's "units".
+const RATIO: (&str, &str) = ("dimensionless", "dimensionless");
+
+/// The efficiencies of the efficiency law, on every joint of either leg mechanism.
+const EFFICIENCY: [Parameter; 2] = [
+    Parameter::new("eta_forward", Sign::Efficiency, "forward transmission efficiency eta_f", RATIO),
+    Parameter::new("eta_backward", Sign::Efficiency, "backward transmission efficiency eta_b", RATIO),
+];
 
 const DRY: (&str, &str) = ("Nm", "N");
 const VISCOUS: (&str, &str) = ("Nm s/rad", "N s/m");
@@ -120,12 +136,12 @@ const SERIAL: [Parameter; 5] = [
 /// rejection rule of the Monte Carlo draws (Section 6.5: "omitted if they are non-physical").
 /// None for a key no table has.
 pub fn physical_bounds(parameter: &str) -> Option<(f64, f64)> {
-    PANTOGRAPH.iter().chain(&PANTOGRAPH_LOAD).chain(&SERIAL).find(|p| p.key == parameter).map(|p| p.sign.interval())
+    PANTOGRAPH.iter().chain(&PANTOGRAPH_LOAD).chain(&SERIAL).chain(&EFFICIENCY).find(|p| p.key == parameter).map(|p| p.sign.interval())
 }
 
 /// The keys of a serial joint's `[model.joint_friction.<joint>]` table, in the documented order.
 pub fn serial_parameters() -> impl Iterator<Item = &'static str> {
-    SERIAL.iter().map(|p| p.key)
+    SERIAL.iter().chain(&EFFICIENCY).map(|p| p.key)
 }
 
 /// Reads a joint's table: every key one of `parameters` (else `unknown` gives the error of a
@@ -179,12 +195,12 @@ impl RawJointFriction {
                             return Err(c.err(&format!("{path}.{key}"), value, "no load dependence on this joint", "the load coefficients a_* only in [model.joint_friction.q_h] (Eq. 5.12 holds for the horizontal joints)"));
                         }
                     }
-                    let parameters: Vec<&Parameter> = PANTOGRAPH.iter().chain(PANTOGRAPH_LOAD.iter().filter(|_| horizontal)).collect();
+                    let parameters: Vec<&Parameter> = PANTOGRAPH.iter().chain(PANTOGRAPH_LOAD.iter().filter(|_| horizontal)).chain(&EFFICIENCY).collect();
                     let values = read(c, &path, joint.kind(), table, &parameters, unknown(&parameters))?;
                     set_pantograph(d, joint, &values);
                 }
                 Robot::Serial(s) => {
-                    let parameters: Vec<&Parameter> = SERIAL.iter().collect();
+                    let parameters: Vec<&Parameter> = SERIAL.iter().chain(&EFFICIENCY).collect();
                     let values = read(c, &path, s.joints.kind(j), table, &parameters, unknown(&parameters))?;
                     set_serial(s, j, &values);
                 }
@@ -194,10 +210,18 @@ impl RawJointFriction {
     }
 }
 
-/// Writes the values of [`PANTOGRAPH`] then [`PANTOGRAPH_LOAD`] (horizontal joint) into every
-/// leg.
+/// Writes the values of [`PANTOGRAPH`], then [`PANTOGRAPH_LOAD`] (horizontal joint), then
+/// [`EFFICIENCY`] into every leg.
 fn set_pantograph(robot: &mut RobotDescription, joint: PantographJoint, values: &[Option<f64>]) {
     let f = &mut robot.friction;
+    let efficiency = match joint {
+        PantographJoint::Rotation => &mut f.efficiency.q_r,
+        PantographJoint::Vertical => &mut f.efficiency.q_v,
+        PantographJoint::Horizontal => &mut f.efficiency.q_h,
+    };
+    let [eta_forward, eta_backward] = [values[values.len() - 2], values[values.len() - 1]];
+    efficiency.eta_forward = eta_forward.unwrap_or(efficiency.eta_forward);
+    efficiency.eta_backward = eta_backward.unwrap_or(efficiency.eta_backward);
     let tables: [&mut PerLeg; 4] = match joint {
         PantographJoint::Rotation => [&mut f.q_r.tau_f_d_plus_nm, &mut f.q_r.f_v_plus_nms, &mut f.q_r.tau_f_d_minus_nm, &mut f.q_r.f_v_minus_nms],
         PantographJoint::Vertical => [&mut f.q_v.tau_f_d_plus_n, &mut f.q_v.f_v_plus_ns_per_m, &mut f.q_v.tau_f_d_minus_n, &mut f.q_v.f_v_minus_ns_per_m],
@@ -225,10 +249,11 @@ fn set_pantograph(robot: &mut RobotDescription, joint: PantographJoint, values: 
     }
 }
 
-/// Writes the values of [`SERIAL`] into the friction of joint `j`'s drive (every leg's).
+/// Writes the values of [`SERIAL`] then [`EFFICIENCY`] into the friction of joint `j`'s drive
+/// (every leg's).
 fn set_serial(robot: &mut SerialRobot, j: usize, values: &[Option<f64>]) {
     let f = &mut robot.drives[j].friction;
-    for (slot, value) in [&mut f.tau_f_d, &mut f.f_v, &mut f.sigma_0, &mut f.sigma_1, &mut f.v_d].into_iter().zip(values) {
+    for (slot, value) in [&mut f.tau_f_d, &mut f.f_v, &mut f.sigma_0, &mut f.sigma_1, &mut f.v_d, &mut f.eta_forward, &mut f.eta_backward].into_iter().zip(values) {
         if let Some(v) = value {
             *slot = *v;
         }

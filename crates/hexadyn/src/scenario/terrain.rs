@@ -117,14 +117,11 @@ pub(super) fn mesh_file(raw: Option<&RawTerrain>, dir: &Path) -> Option<String> 
 /// The rows of a CSV file of numbers (blank lines skipped).
 fn read_heights(path: &Path) -> Result<Vec<Vec<f64>>, String> {
     let text = crate::fields::read_input(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    let mut rows = Vec::new();
-    for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
-        let row = line
-            .split(',')
-            .enumerate()
-            .map(|(k, v)| v.trim().parse::<f64>().map_err(|_| format!("{}:{}: column {}: `{}` is not a number", path.display(), n + 1, k + 1, v.trim())))
-            .collect::<Result<Vec<f64>, String>>()?;
-        rows.push(row);
-    }
-    Ok(rows)
+    let records = crate::fields::csv_records(&text, false).map_err(|(line, e)| format!("{}:{line}: {e}", path.display()))?;
+    records
+        .into_iter()
+        .map(|(line, fields)| {
+            fields.iter().enumerate().map(|(k, v)| v.parse::<f64>().map_err(|_| format!("{}:{line}: column {}: `{v}` is not a number", path.display(), k + 1))).collect()
+        })
+        .collect()
 }

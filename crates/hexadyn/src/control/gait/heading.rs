@@ -110,37 +110,34 @@ pub struct SeriesError {
 
 impl Series {
     /// Reads a CSV file with the header `t,vx,vy,omega_z` (s, m/s, m/s, rad/s), times strictly
-    /// increasing.
+    /// increasing (the `csv` crate, [`crate::fields::csv_records`]: lines starting with `#`
+    /// are comments).
     pub fn from_csv(path: &Path) -> Result<Self, SeriesError> {
         let file = path.display().to_string();
         let err = |line: usize, problem: String| SeriesError { file: file.clone(), line, problem };
         let text = crate::fields::read_input(path).map_err(|e| err(0, format!("cannot read: {e}")))?;
-        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-        let (n, header) = lines.next().ok_or_else(|| err(1, "empty file; expected the header t,vx,vy,omega_z".into()))?;
-        let names: Vec<&str> = header.split(',').map(str::trim).collect();
-        if names != ["t", "vx", "vy", "omega_z"] {
-            return Err(err(n + 1, format!("header {header:?}; expected t,vx,vy,omega_z")));
+        let mut records = crate::fields::csv_records(&text, true).map_err(|(line, e)| err(line, e))?.into_iter();
+        let (n, header) = records.next().ok_or_else(|| err(1, "empty file; expected the header t,vx,vy,omega_z".into()))?;
+        if header != ["t", "vx", "vy", "omega_z"] {
+            return Err(err(n, format!("header {:?}; expected t,vx,vy,omega_z", header.join(","))));
         }
         let mut series = Series { t: Vec::new(), headings: Vec::new() };
-        for (n, line) in lines {
-            let values: Vec<f64> = line
-                .split(',')
-                .map(|v| v.trim().parse::<f64>().map_err(|_| err(n + 1, format!("value {:?} is not a number", v.trim()))))
-                .collect::<Result<_, _>>()?;
+        for (n, fields) in records {
+            let values: Vec<f64> = fields.iter().map(|v| v.parse::<f64>().map_err(|_| err(n, format!("value {v:?} is not a number")))).collect::<Result<_, _>>()?;
             if values.len() != 4 {
-                return Err(err(n + 1, format!("{} values; expected 4 (t, vx, vy, omega_z)", values.len())));
+                return Err(err(n, format!("{} values; expected 4 (t, vx, vy, omega_z)", values.len())));
             }
             if let Some(v) = values.iter().find(|v| !v.is_finite()) {
-                return Err(err(n + 1, format!("value {v} is not finite")));
+                return Err(err(n, format!("value {v} is not finite")));
             }
             if series.t.last().is_some_and(|&last| values[0] <= last) {
-                return Err(err(n + 1, format!("t = {} does not increase", values[0])));
+                return Err(err(n, format!("t = {} does not increase", values[0])));
             }
             series.t.push(values[0]);
             series.headings.push(Heading::new(values[1], values[2], values[3]));
         }
         if series.t.is_empty() {
-            return Err(err(n + 1, "no data rows".into()));
+            return Err(err(n, "no data rows".into()));
         }
         Ok(series)
     }

@@ -91,6 +91,7 @@ fn friction_element(d: &RobotDescription, leg: usize, joint: PantographJoint, op
             };
             JointFriction::LuGre(LuGre { sigma_0, sigma_1, v_d, f_v_plus, f_v_minus, steady })
         }
+        FrictionModel::Efficiency => JointFriction::Efficiency(parameters.efficiency()),
     };
     let element = FrictionElement::new(law);
     match (options.load_dependence, options.friction, load_dependence) {

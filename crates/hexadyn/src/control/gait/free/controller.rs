@@ -13,6 +13,7 @@
 use nalgebra::{Vector2, Vector3};
 
 use super::elevator::{resistance, retreat};
+use super::five_legs::{bands, Band};
 use crate::control::settling_time;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
@@ -147,6 +148,9 @@ pub struct FreeGaitController<L: LegMechanism = LegKinematics> {
     neighbours: [Option<(usize, usize)>; 6],
     /// Offset of each leg's footholds from its workspace centre (leg frame): zero on six legs.
     foothold_offset: [Vector3<f64>; 6],
+    /// The half-planes of the body frame the support feet keep to on five legs
+    /// ([`super::five_legs`]), for the walk of the current update.
+    bands: [Option<Band>; 6],
     /// Highest foot of each leg's reach (leg frame, m).
     reach_top: [f64; 6],
     /// Where the failed leg's foot is held ([`held_up`]), found once (leg frame).
@@ -185,6 +189,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
             landing,
             neighbours,
             foothold_offset,
+            bands: [None; 6],
             reach_top,
             held_up,
             walk: Walk { body: None, legs: [idle; 6] },
@@ -287,6 +292,8 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// support motion for about the takeoff time; the AEP is set back by that distance,
     /// |v_C| t_takeoff, and by the security margin of the constrained working volume (Section
     /// 7.1.1, [`AEP_SECURITY`]), so that the touchdown is inside the boundary and not beyond it.
+    /// With a band ([`super::five_legs`]) the AEP is moved across the body, along the band's
+    /// normal, to the security margin inside it.
     fn aep(&self, leg: usize, v_c: &Vector3<f64>, z: f64) -> Vector3<f64> {
         let w = &self.workspaces[leg];
         let v = Vector3::new(v_c.x, v_c.y, 0.0);
@@ -300,7 +307,8 @@ impl<L: LegMechanism> FreeGaitController<L> {
             let reach = -ou + (ou * ou + w.radius * w.radius - offset.norm_squared()).max(0.0).sqrt();
             aep += u * (reach - speed * self.options.takeoff_time - AEP_SECURITY).max(0.0);
         }
-        aep
+        let kin = &self.legs_kinematics[leg];
+        self.bands[leg].map_or(aep, |b| aep + kin.direction_to_leg(&b.normal) * b.shortfall(&kin.to_body(&aep), AEP_SECURITY))
     }
 
     /// Kinematic margin (Section 7.7.3) of the foot at `p` moving at −v_C in its leg frame:
@@ -309,11 +317,26 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// INTERPRETATION: on uneven ground the feet leave the cylinder's height range (its caps
     /// bound the foot heights on flat ground); the posture control keeps the heights, and the
     /// margin that selects the swing and the deadlock is the horizontal one, "the remaining
-    /// distance to travel (in the direction of the robot motion)".
+    /// distance to travel (in the direction of the robot motion)". With a band
+    /// ([`super::five_legs`]), the smaller of that and the distance to the band's edge.
     fn margin(&self, leg: usize, p: &Vector3<f64>, v_c: &Vector3<f64>) -> f64 {
         let w = &self.workspaces[leg];
         let level = Vector3::new(p.x, p.y, p.z.clamp(w.z_min, w.z_max));
-        w.margin(&level, &Vector3::new(-v_c.x, -v_c.y, 0.0))
+        let motion = Vector3::new(-v_c.x, -v_c.y, 0.0);
+        let kinematic = w.margin(&level, &motion);
+        let kin = &self.legs_kinematics[leg];
+        let along = kin.body_from_leg().rotation * motion;
+        self.bands[leg].filter(|_| along.norm() > 0.0).map_or(kinematic, |b| kinematic.min(b.margin(&kin.to_body(p), &along.normalize())))
+    }
+
+    /// The bands of the feet for the walk commanded by `h` with the body at `desired`
+    /// ([`super::five_legs::bands`]): the feet keep the stability margin and the security margin
+    /// of the working volume beyond the body centre. None on six legs.
+    fn bands_for(&self, desired: &Htm, h: &Heading) -> [Option<Band>; 6] {
+        let Some(failed) = self.options.failed_leg else { return [None; 6] };
+        let centres = std::array::from_fn(|l| self.legs_kinematics[l].to_body(&self.workspaces[l].centre_at(-self.options.body_height)));
+        let radii = self.workspaces.map(|w| w.radius);
+        bands(failed, &(desired.rotation.transpose() * h.velocity), &centres, &radii, self.options.stability_margin + AEP_SECURITY)
     }
 
     /// The legs that lift now among the Rule 2-3 candidates, in order of increasing margin, those
@@ -380,10 +403,16 @@ impl<L: LegMechanism> FreeGaitController<L> {
         }
         let towards = towards.normalize() * speed;
         let mut u = Vector3::new(towards.x, towards.y, 0.0);
-        // The outward normal (global, horizontal) of each foot at its boundary.
+        // The outward normal (global, horizontal) of each foot at its boundary: its band's edge
+        // when it is outside its band (at the start), else the side of its workspace.
         let outward = |k: usize| {
-            let out = self.walk.legs[k].foot.xy() - self.workspaces[k].centre;
-            let n = self.leg_frame(k, desired).rotation * Vector3::new(out.x, out.y, 0.0);
+            let n = match self.bands[k].filter(|b| b.depth(&self.legs_kinematics[k].to_body(&self.walk.legs[k].foot)) < 0.0) {
+                Some(b) => desired.rotation * -b.normal,
+                None => {
+                    let out = self.walk.legs[k].foot.xy() - self.workspaces[k].centre;
+                    self.leg_frame(k, desired).rotation * Vector3::new(out.x, out.y, 0.0)
+                }
+            };
             Vector3::new(n.x, n.y, 0.0).normalize()
         };
         let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary).collect();
@@ -394,7 +423,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
         // The foot moves by −u dt relative to its leg frame.
         let stays = |k: usize| {
             let p = self.walk.legs[k].foot - self.leg_frame(k, desired).rotation.transpose() * u * self.options.dt;
-            (p.xy() - self.workspaces[k].centre).norm() <= self.workspaces[k].radius
+            (p.xy() - self.workspaces[k].centre).norm() <= self.workspaces[k].radius && self.bands[k].is_none_or(|b| b.depth(&self.legs_kinematics[k].to_body(&p)) >= 0.0)
         };
         let outwards = at_boundary.iter().any(|&k| u.dot(&outward(k)) < -1e-9 * speed);
         let leaves = (0..6).any(|k| standing[k] && margins[k] >= boundary && !stays(k));
@@ -568,6 +597,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         let desired = body.pose.htm();
         let estimated = estimated_pose(m, &body.pose);
 
+        self.bands = self.bands_for(&desired, &h);
         let mut references = [0.0; JOINTS];
         let (mut reaching_down, mut room) = (false, f64::INFINITY);
         let mut margins = [f64::INFINITY; 6];

@@ -6,6 +6,7 @@
 
 mod controller;
 pub mod elevator;
+pub mod five_legs;
 pub mod landing;
 pub mod posture;
 pub mod rules;
