@@ -341,6 +341,39 @@ def test_shipped_efficiency_study_sets_the_efficiency_law_beside_the_load_depend
     assert dry < xi[0.638] < load, (dry, xi[0.638], load)
 
 
+#: The robots of the "AMRU5 bis" studies, each set for every run as the study files say (--set).
+BIS_ROBOTS = ("amru5", "amru5_backdrivable", "amru5_series_elastic")
+
+
+def test_shipped_bis_studies_compare_the_drives(tmp_path: Path):
+    """docs/studies.md, AMRU5 bis: the walk study at Table 6.2's velocities on one step (12 s) of
+    its walk and the unpowered stand study in full, once per robot. The backdrivable drives
+    cost less than AMRU5 at every velocity, the series springs' deflection shows in the q_v
+    tracking; unpowered, AMRU5 stands, the backdrivable robot keeps sinking (farther at 10 s
+    than at 3 s) and the series-elastic one sinks by its springs' deflection and stands (the
+    same height at 3 s and 10 s)."""
+    walk, stand = read_study(STUDIES / "amru5_bis.toml"), read_study(STUDIES / "amru5_bis_unpowered.toml")
+    assert (walk.scenario, walk.design.method, [p.key for p in walk.parameters]) == ("validation_tripod_1_5cm", "grid", ["gait.heading.vx_m_s"])
+    assert walk.parameters[0].values == (0.01, 0.015, 0.02, 0.025)
+    assert (stand.scenario, [p.key for p in stand.parameters]) == ("unpowered_lugre", ["initial.q_v_m", "scenario.duration_s"])
+    walks, stands = {}, {}
+    for robot in BIS_ROBOTS:
+        runs = Study.create(walk, fixed={"scenario.robot": robot, "scenario.duration_s": 12.0}).run(tmp_path / "walk" / robot, workers=2, progress=False, plots=False).runs
+        assert (runs["status"] == "ok").all(), runs
+        walks[robot] = runs.set_index("gait.heading.vx_m_s")
+        runs = Study.create(stand, fixed={"scenario.robot": robot}).run(tmp_path / "stand" / robot, workers=2, progress=False, plots=False).runs
+        assert (runs["status"] == "ok").all(), runs
+        stands[robot] = runs.pivot(index="initial.q_v_m", columns="scenario.duration_s", values="body_height_change_m")
+    xi = {robot: walks[robot]["specific_resistance"] for robot in BIS_ROBOTS}
+    assert (xi["amru5_backdrivable"] < 0.5 * xi["amru5"]).all(), xi
+    tracking = {robot: walks[robot]["max_tracking_error_q_v_m"] for robot in BIS_ROBOTS}
+    assert (tracking["amru5_series_elastic"] > tracking["amru5"] + 0.5e-3).all(), tracking
+    assert (stands["amru5"].abs() < 0.02e-3).all(axis=None), stands["amru5"]
+    backdrivable, springs = stands["amru5_backdrivable"], stands["amru5_series_elastic"]
+    assert (backdrivable[10.0] < 2 * backdrivable[3.0]).all() and (backdrivable[3.0] < -1e-3).all(), backdrivable
+    assert ((springs[10.0] - springs[3.0]).abs() < 1e-6).all() and (springs[10.0] < -4e-3).all(), springs
+
+
 # ----------------------------------------------------------------------------------------------
 # Validation: one line naming the file, the field, the value and what is allowed
 # ----------------------------------------------------------------------------------------------

@@ -41,6 +41,7 @@ fn model(robot: &SerialHexapod) -> Arc<RobotModel> {
         pi_gains: [PI_GAINS; JOINTS],
         encoders: [Encoder { counts_per_rev: 4096, n: motor.n }; JOINTS],
         servos: None,
+        series: None,
     };
     let options = ModelOptions {
         friction: FrictionModel::DryViscous,

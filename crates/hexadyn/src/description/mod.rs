@@ -60,12 +60,17 @@ pub const PHANTOMX_TOML: &str = include_str!("../../../../robots/phantomx/phanto
 /// "AMRU5 bis"), embedded: it extends `amru5`.
 pub const AMRU5_BACKDRIVABLE_TOML: &str = include_str!("../../../../robots/amru5_backdrivable.toml");
 
+/// AMRU5 with series-elastic transmissions (`robots/amru5_series_elastic.toml`, issue 40's
+/// "AMRU5 bis"), embedded: it extends `amru5`.
+pub const AMRU5_SERIES_ELASTIC_TOML: &str = include_str!("../../../../robots/amru5_series_elastic.toml");
+
 /// The robots a scenario names by `scenario.robot = "<name>"`: name, embedded text, the file it
 /// was embedded from (named in errors).
-pub const SHIPPED_ROBOTS: [(&str, &str, &str); 3] = [
+pub const SHIPPED_ROBOTS: [(&str, &str, &str); 4] = [
     ("amru5", AMRU5_TOML, AMRU5_ORIGIN),
     ("phantomx", PHANTOMX_TOML, "robots/phantomx/phantomx.toml"),
     ("amru5_backdrivable", AMRU5_BACKDRIVABLE_TOML, "robots/amru5_backdrivable.toml"),
+    ("amru5_series_elastic", AMRU5_SERIES_ELASTIC_TOML, "robots/amru5_series_elastic.toml"),
 ];
 
 /// Name used in error messages for the embedded file.

@@ -508,6 +508,7 @@ impl SerialRobot {
             pi_gains: std::array::from_fn(|k| self.pi_gains(k)),
             encoders: std::array::from_fn(encoder),
             servos: self.has_servos().then(|| std::array::from_fn(|k| self.servo(k))),
+            series: None,
         }
     }
 

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use super::tables::{DriverTable, LegTable, MissingA1MinusRule, MissingStictionRule, MotorTable, NegativeViscousRule, RobotDescription};
 use crate::hexapod::{PantographJoint, JOINTS, LEG_COUNT};
-use crate::physics::{DryViscous, Efficiency, LoadDependence};
+use crate::physics::{DryViscous, Efficiency, LoadDependence, SeriesSpring};
 
 impl MotorTable {
     /// L in H.
@@ -177,6 +177,17 @@ impl RobotDescription {
             PantographJoint::Vertical => (r.q_v_m.min, r.q_v_m.max),
             PantographJoint::Horizontal => (r.q_h_m.min, r.q_h_m.max),
         }
+    }
+
+    /// The series-elastic spring of a joint (stiffness in N/m or Nm/rad, damping in N s/m or
+    /// Nm s/rad), None for AMRU5's rigid drives.
+    pub fn series_spring(&self, joint: PantographJoint) -> Option<SeriesSpring> {
+        let s = self.series_elastic.as_ref()?;
+        Some(match joint {
+            PantographJoint::Rotation => SeriesSpring { stiffness: s.q_r.stiffness_nm_per_rad, damping: s.q_r.damping_nms_per_rad },
+            PantographJoint::Vertical => SeriesSpring { stiffness: s.q_v.stiffness_n_per_m, damping: s.q_v.damping_ns_per_m },
+            PantographJoint::Horizontal => SeriesSpring { stiffness: s.q_h.stiffness_n_per_m, damping: s.q_h.damping_ns_per_m },
+        })
     }
 
     /// PI gains of each joint k = 3 leg + j in SI (Table 4.1).

@@ -50,6 +50,10 @@ pub struct RobotDescription {
     pub friction: FrictionTable,
     /// Section 6.5, Table 6.7.
     pub monte_carlo: MonteCarloTable,
+    /// Series-elastic transmissions (issue 40's "AMRU5 bis"): a spring between each gear output
+    /// and its joint; absent on AMRU5, whose drives are rigid.
+    #[serde(default)]
+    pub series_elastic: Option<SeriesElasticTable>,
     /// Where the description was read from (file path or origin name); not in the file.
     #[serde(skip)]
     pub origin: String,
@@ -739,4 +743,34 @@ pub struct MonteCarloHorizontalTable {
     pub tau_f_d_plus_n: Gaussian,
     #[serde(deserialize_with = "Negative::gaussian")]
     pub tau_f_d_minus_n: Gaussian,
+}
+
+/// `[series_elastic]`: the spring of each joint kind's series-elastic transmission, between the
+/// gear output (the ball-screw nut, the q_r sprocket) and the joint, the same on every leg.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SeriesElasticTable {
+    pub q_r: RotationalSpringTable,
+    pub q_v: LinearSpringTable,
+    pub q_h: LinearSpringTable,
+}
+
+/// `[series_elastic.q_r]`: a torsional spring and its damping.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RotationalSpringTable {
+    #[serde(deserialize_with = "Positive::checked")]
+    pub stiffness_nm_per_rad: f64,
+    #[serde(deserialize_with = "NonNegative::checked")]
+    pub damping_nms_per_rad: f64,
+}
+
+/// `[series_elastic.q_v]`, `[series_elastic.q_h]`: a linear spring and its damping.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LinearSpringTable {
+    #[serde(deserialize_with = "Positive::checked")]
+    pub stiffness_n_per_m: f64,
+    #[serde(deserialize_with = "NonNegative::checked")]
+    pub damping_ns_per_m: f64,
 }

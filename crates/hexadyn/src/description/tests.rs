@@ -340,3 +340,20 @@ fn extends_errors_name_the_file_and_the_field() {
     let s = bad("extends = \"amru5\"\n[reductions.components]\ngearbox_h = 1.0\n");
     assert!(s.starts_with("bis.toml: field `reductions.n_h_rad_per_m`") && s.contains("base robot \"amru5\""), "{s}");
 }
+
+/// The series-elastic transmissions (`robots/amru5_series_elastic.toml`): AMRU5 with a
+/// `[series_elastic]` table, every other table the base's; each joint kind's spring in SI, the
+/// same foot stiffness through the pantograph's ratios (k_v / 36 = k_h / 49, Eq. B.1-B.2).
+#[test]
+fn series_elastic_transmissions_extend_amru5() {
+    let mut base = amru5();
+    let sea = RobotDescription::from_str(AMRU5_SERIES_ELASTIC_TOML, "robots/amru5_series_elastic.toml").expect("shipped description loads");
+    assert_eq!(sea.name, "AMRU5 series-elastic");
+    assert!(base.series_spring(PantographJoint::Vertical).is_none());
+    let spring = |joint| sea.series_spring(joint).expect("every joint has its spring");
+    assert_eq!((spring(PantographJoint::Rotation).stiffness, spring(PantographJoint::Rotation).damping), (1.37e3, 8.95));
+    assert_eq!((spring(PantographJoint::Vertical).stiffness, spring(PantographJoint::Vertical).damping), (3.86e5, 2530.0));
+    assert_relative_eq!(spring(PantographJoint::Vertical).stiffness / 36.0, spring(PantographJoint::Horizontal).stiffness / 49.0, max_relative = 2e-3); // three digits
+    (base.name, base.origin, base.series_elastic) = (sea.name.clone(), sea.origin.clone(), sea.series_elastic);
+    assert_eq!(base, sea);
+}

@@ -392,7 +392,7 @@ impl<S: Drive> Slaves<S> {
     fn apply(&mut self, command: &Commands<S>, received: Instant, to: SocketAddr) {
         let state = self.robot.state();
         let q = state.q.as_slice();
-        let counts: [i64; JOINTS] = std::array::from_fn(|k| self.scales[k].count(q[6 + k]));
+        let counts: [i64; JOINTS] = std::array::from_fn(|k| self.scales[k].count(q[self.robot.robot.model.drive_index(k)]));
         let currents = self.robot.robot.outputs.current;
         let supply = self.robot.robot.model.options.supply_voltage;
         let n = self.report.commands;

@@ -1,5 +1,6 @@
 //! Physical elements of the robot model (thesis Section 3.4.2-3.4.4, Chapter 5, Section 6.1):
-//! the terrain and the ground contact, joint friction, DC motors and their current sensors.
+//! the terrain and the ground contact, joint friction, DC motors and their current sensors, the
+//! springs of series-elastic transmissions.
 //!
 //! Each element is a set of small pure functions returning its value with the exact partial
 //! derivatives with respect to each argument, from which the assembler of the global residual
@@ -9,6 +10,7 @@ mod contact;
 mod current_sensor;
 mod friction;
 mod motor;
+mod series_elastic;
 pub mod terrain;
 
 pub use contact::{ContactForce, GroundContact};
@@ -19,3 +21,4 @@ pub use friction::{
     LOAD_GRAVITY,
 };
 pub use motor::{limit_switch, saturate, Current, CurrentResidual, DcMotor};
+pub use series_elastic::SeriesSpring;

@@ -35,12 +35,13 @@
 //! | `tau_m_q_v[i]` ... | Nm (q_r), N | motor torque at the joint, n k_t i |
 //! | `tau_f_q_v[i]` ... | Nm (q_r), N | joint friction torque |
 //! | `z_q_v[i]` ... | rad (q_r), m | LuGre bristle deflection (friction `lugre` only) |
+//! | `drive_q_v[i]` ... | rad (q_r), m | drive position θ of a series-elastic transmission (the gear output, what the encoder reads; the spring's deflection is θ − q) |
 //! | `Fx[f]`, `Fy[f]`, `Fz[f]`, `Fn[f]` | N | ground force on foot f (global frame), normal part |
 //! | `penetration[f]` | m | δ: > 0 in the ground, < 0 the clearance |
 //! | `foot_x[f]`, `foot_y[f]`, `foot_z[f]` | m | foot position (global frame) |
 //! | `E_el_q_v[i]`, `E_joule_q_v[i]`, `E_fric_q_v[i]` ... | J | cumulative electrical energy ∫u i dt, Joule losses, friction work ∫τ_f q' dt |
 //! | `E_kin`, `E_pot` | J | kinetic and gravitational potential energy |
-//! | `E_contact`, `E_stored`, `E_balance` | J | cumulative work on the ground; energy in bristles, ground springs and inductances; energy balance error |
+//! | `E_contact`, `E_stored`, `E_balance` | J | cumulative work on the ground; energy in bristles, series springs, ground springs and inductances; energy balance error |
 //!
 //! | `F_gnd_est[l]`, `gnd_detected[l]` | N; 1 | ground force estimate and detection flag of leg l (ground_detection) |
 //! | `gd_leg`, `gd_threshold`, `gd_trial`, `gd_hold`, `gd_stop` | 1; N; 1; 1; 1 | tested leg, threshold, trial, stopped flag, stop instant (ground_detection) |
@@ -105,6 +106,10 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     rec.put_each(&meas.currents, |k| (joints.column("i_meas_", k, ""), "A", s("motor current measured at t: analog 30 Hz low-pass, plus the sensor noise (Section 5.6.2)")));
     rec.put_each(&out.motor_torque, |k| (joints.column("tau_m_", k, ""), joints.unit(k, ("Nm", "N")), s("motor torque at the joint, n k_t i")));
     rec.put_each(&out.friction_torque, |k| (joints.column("tau_f_", k, ""), joints.unit(k, ("Nm", "N")), s("joint friction torque (opposing the motion)")));
+    if p.robot.model.series.is_some() {
+        let drives: [f64; JOINTS] = std::array::from_fn(|k| q[p.robot.model.drive_index(k)]);
+        rec.put_each(&drives, |k| (joints.column("drive_", k, ""), joints.unit(k, ("rad", "m")), s("series-elastic drive position (gear output, read by the encoder)")));
+    }
     if groups.bristles {
         rec.put_each(&out.bristle, |k| (joints.column("z_", k, ""), joints.unit(k, ("rad", "m")), s("LuGre bristle deflection")));
     }
@@ -126,7 +131,7 @@ pub fn record_row(rec: &mut Recorder, p: &SimulatedRobot, meas: &Measurements, c
     rec.put(e.kinetic, || (s("E_kin"), "J", s("kinetic energy")));
     rec.put(e.potential, || (s("E_pot"), "J", s("gravitational potential energy")));
     rec.put(e.contact_work.iter().sum(), || (s("E_contact"), "J", s("cumulative work of the feet on the ground")));
-    rec.put(e.bristle_energy + e.contact_energy + e.magnetic_energy, || (s("E_stored"), "J", s("energy stored in bristles, ground springs and inductances")));
+    rec.put(e.bristle_energy + e.spring_energy + e.contact_energy + e.magnetic_energy, || (s("E_stored"), "J", s("energy stored in bristles, series springs, ground springs and inductances")));
     rec.put(e.balance_error(&p.initial_energy), || (s("E_balance"), "J", s("energy balance error so far (electrical in minus what it became)")));
     rec.end_row();
 }

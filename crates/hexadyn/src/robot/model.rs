@@ -3,7 +3,10 @@
 //! dry/viscous, LuGre with its 18 bristle states, or transmission efficiency) and the 18 DC motors with their H-bridge
 //! (inductance neglected, Eq. 4.4, or kept as 18 current states, Eq. 3.91).
 //!
-//! Rows and coordinates: q (24, Eq. 3.51), then the bristle states z = q'_z (Eq. 3.85), then the
+//! Rows and coordinates: q (24, Eq. 3.51), then with series-elastic transmissions the drive
+//! coordinates θ (18, the gear outputs in joint units: what the motor turns, the transmission's
+//! friction slides and the encoder reads; the spring between θ and q moves the joint), then the
+//! bristle states z = q'_z (Eq. 3.85), then the
 //! motor currents i = q'_i (Eq. 3.91) when they are states, then, with continuous joint
 //! controllers (the 96-DOF model of Table 3.5), per joint the PID states q_u (u = q'_u) and q_I
 //! (Eq. 3.96-3.97). Inputs: the 18 voltages commanded by the digital controllers, held between
@@ -28,7 +31,7 @@ use crate::sim::{Jacobian, Layout, Order, System};
 mod inertial;
 mod parts;
 mod surrogate;
-pub use parts::RobotParts;
+pub use parts::{RobotParts, SeriesElastic};
 use inertial::InertialJacobian;
 use surrogate::Surrogate;
 
@@ -142,7 +145,11 @@ pub struct RobotModel {
     /// Position servos ([`PositionServo`]): the motors are driven by the servos' own loops and
     /// the model's inputs are the goal positions.
     pub servos: Option<[PositionServo; JOINTS]>,
+    /// Series-elastic transmissions ([`SeriesElastic`]), per joint.
+    pub series: Option<[SeriesElastic; JOINTS]>,
     layout: Layout,
+    /// First drive coordinate θ (series-elastic transmissions).
+    drives: Option<usize>,
     bristles: Option<usize>,
     currents: Option<usize>,
     /// First PID state: q_u of joint k at `pid + 2k`, q_I at `pid + 2k + 1`.
@@ -159,7 +166,7 @@ impl RobotModel {
     /// scales by their kind: 1e-5 rad, 1e-7 m), the bristle, current and PID states the options
     /// ask for.
     pub fn assemble(parts: RobotParts, options: ModelOptions, terrain: Arc<dyn Terrain>) -> Self {
-        let RobotParts { multibody, feet, joints, mut motors, friction, strokes, pi_gains, encoders, servos } = parts;
+        let RobotParts { multibody, feet, joints, mut motors, friction, strokes, pi_gains, encoders, servos, series } = parts;
         assert!(servos.is_none() || options.control == JointControl::Digital, "position servos run their own loops: no continuous PID on them");
         for motor in &mut motors {
             motor.inductance = options.inductance;
@@ -171,10 +178,17 @@ impl RobotModel {
         }
         let joint_name = |k: usize| joints.column("", k, "");
         let revolute = |k: usize| joints.kind(k % 3) == JointKind::Revolute;
+        let joint_scale = |k: usize| if revolute(k) { 1e-5 } else { 1e-7 };
         for k in 0..JOINTS {
-            let scale = if revolute(k) { 1e-5 } else { 1e-7 };
-            layout.push(joint_name(k), Order::Second, scale, format!("multibody (leg {})", k / 3));
+            layout.push(joint_name(k), Order::Second, joint_scale(k), format!("multibody (leg {})", k / 3));
         }
+        let drives = series.is_some().then(|| {
+            let first = layout.len();
+            for k in 0..JOINTS {
+                layout.push(format!("drive_{}", joint_name(k)), Order::Second, joint_scale(k), format!("series-elastic drive {}", joint_name(k)));
+            }
+            first
+        });
         let bristles = (options.friction == FrictionModel::LuGre).then(|| {
             let first = layout.len();
             for (k, f) in friction.iter().enumerate() {
@@ -204,13 +218,20 @@ impl RobotModel {
             }
             first
         });
-        RobotModel { multibody, feet, joints, motors, friction, strokes, options, terrain, pids, encoders, servos, layout, bristles, currents, pid }
+        RobotModel { multibody, feet, joints, motors, friction, strokes, options, terrain, pids, encoders, servos, series, layout, drives, bristles, currents, pid }
     }
 
-    /// Number of coordinates: 24, + 18 bristles with LuGre, + 18 currents with inductance,
+    /// Number of coordinates: 24, + 18 drive coordinates with series-elastic transmissions,
+    /// + 18 bristles with LuGre, + 18 currents with inductance,
     /// + 36 with continuous PID controllers (42 for the model of Section 4.5, 96 for Table 3.5).
     pub fn coordinate_count(&self) -> usize {
         self.layout.len()
+    }
+    /// Index of the drive position of joint k: what its motor turns, its transmission's friction
+    /// slides, its encoder reads and its limit switches watch. The drive coordinate θ of a
+    /// series-elastic transmission, else the joint itself (6 + k).
+    pub fn drive_index(&self, k: usize) -> usize {
+        self.drives.map_or(6 + k, |d| d + k)
     }
     /// Index of the bristle state of joint k, if any.
     pub fn bristle_index(&self, k: usize) -> Option<usize> {
@@ -236,10 +257,14 @@ impl RobotModel {
 
     /// Initial q for the given joint positions: body at (0, 0, Z) with zero yaw, parallel to the
     /// terrain below its origin (level on flat ground), Z chosen so that the lowest foot just
-    /// touches the terrain (closest point: zero penetration); all other states zero.
+    /// touches the terrain (closest point: zero penetration); series springs undeflected; all
+    /// other states zero.
     pub fn touching_ground(&self, joints: &[f64; JOINTS]) -> Vec<f64> {
         let mut q = vec![0.0; self.coordinate_count()];
         q[6..DOF].copy_from_slice(joints);
+        if let Some(d) = self.drives {
+            q[d..d + JOINTS].copy_from_slice(joints);
+        }
         // z_b = n: R_y(Θ) R_x(Ψ) e_z = (sin Θ cos Ψ, −sin Ψ, cos Θ cos Ψ) (Eq. 3.52 with Φ = 0).
         let n = self.terrain.height_normal(0.0, 0.0).1;
         (q[4], q[5]) = (n.x.atan2(n.z), (-n.y).asin());
@@ -276,6 +301,9 @@ pub struct Outputs {
     pub current: [f64; JOINTS],
     /// Joint torque of the motor n k_t i (Nm or N).
     pub motor_torque: [f64; JOINTS],
+    /// The generalized force on each joint (Nm or N): τ_m − τ_f through a rigid drive, the
+    /// spring's τ_s through a series-elastic one.
+    pub joint_force: [f64; JOINTS],
     /// Friction torque τ_f opposing the motion (Nm or N).
     pub friction_torque: [f64; JOINTS],
     /// Bristle deflection z (rad or m); zero without LuGre.
@@ -358,7 +386,7 @@ impl Robot {
             self.references = command.goals.unwrap_or(command.references);
         } else {
             for k in 0..JOINTS {
-                self.voltages[k] = limit_switch(command.voltages[k], q[6 + k], &self.model.strokes[k]);
+                self.voltages[k] = limit_switch(command.voltages[k], q[self.model.drive_index(k)], &self.model.strokes[k]);
             }
         }
     }
@@ -385,7 +413,7 @@ impl Robot {
             }
         }
         for k in 0..JOINTS {
-            self.data.add_generalized_force(6 + k, self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
+            self.data.add_generalized_force(6 + k, self.outputs.joint_force[k]);
         }
     }
 
@@ -405,26 +433,31 @@ impl Robot {
             out.contact[leg] = c;
             out.foot[leg] = foot.position;
         }
-        // Motors (Eq. 3.90-3.92 or 4.4-4.7) and joint friction (Eq. 6.1 or 3.87).
+        // Motors (Eq. 3.90-3.92 or 4.4-4.7) and joint friction (Eq. 6.1 or 3.87) at the drive
+        // position d; the series springs between the drives and the joints.
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let (j, d) = (6 + k, m.drive_index(k));
             let motor = &m.motors[k];
             let commanded = match (m.pid, &m.servos) {
                 (Some(p), _) => qd[p + 2 * k],
-                (None, Some(servos)) => servos[k].voltage(self.references[k], q[j], m.options.supply_voltage).u,
+                (None, Some(servos)) => servos[k].voltage(self.references[k], q[d], m.options.supply_voltage).u,
                 (None, None) => self.voltages[k],
             };
             let u = saturate(commanded, m.options.supply_voltage);
             let i = match m.currents {
                 Some(c) => qd[c + k],
-                None => motor.current(qd[j], u).i,
+                None => motor.current(qd[d], u).i,
             };
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
             let load = out.contact[k / 3].normal_force;
             out.voltage[k] = u;
             out.current[k] = i;
             out.motor_torque[k] = motor.joint_torque(i).0;
-            out.friction_torque[k] = m.friction[k].torque(qd[j], z, zdot, load, out.motor_torque[k]).tau;
+            out.friction_torque[k] = m.friction[k].torque(qd[d], z, zdot, load, out.motor_torque[k]).tau;
+            out.joint_force[k] = match &m.series {
+                Some(series) => series[k].spring.force(q[d] - q[j], qd[d] - qd[j]),
+                None => out.motor_torque[k] - out.friction_torque[k],
+            };
             out.bristle[k] = z;
         }
     }
@@ -435,26 +468,31 @@ impl Robot {
         self.write_state_rows(q, qd, qdd, f);
     }
 
-    /// The rows after the multibody ones: bristles (Eq. 3.85), currents (Eq. 3.91), continuous
-    /// controllers (Eq. 3.96-3.97), from [`Self::outputs`]; the held body's on a stand.
+    /// The rows after the multibody ones: the series-elastic drives (J θ'' = τ_m − τ_f − τ_s),
+    /// bristles (Eq. 3.85), currents (Eq. 3.91), continuous controllers (Eq. 3.96-3.97), from
+    /// [`Self::outputs`]; the held body's on a stand.
     fn write_state_rows(&self, q: &[f64], qd: &[f64], qdd: &[f64], f: &mut [f64]) {
         let m = &*self.model;
+        let out = &self.outputs;
         if m.options.stand {
             f[..BODY].copy_from_slice(&qdd[..BODY]);
         }
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let d = m.drive_index(k);
+            if let Some(series) = &m.series {
+                f[d] = series[k].drive_inertia * qdd[d] - out.motor_torque[k] + out.friction_torque[k] + out.joint_force[k];
+            }
             if let Some(b) = m.bristles {
-                let load = self.outputs.contact[k / 3].normal_force;
-                f[b + k] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).map_or(0.0, |r| r.f);
+                let load = out.contact[k / 3].normal_force;
+                f[b + k] = m.friction[k].bristle_residual(qd[d], qd[b + k], qdd[b + k], load).map_or(0.0, |r| r.f);
             }
             if let Some(c) = m.currents {
-                f[c + k] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).f;
+                f[c + k] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[d], out.voltage[k]).f;
             }
             if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
                 let (u, i) = (p + 2 * k, p + 2 * k + 1);
                 f[u] = pids[k].voltage_residual(qd[u], qdd[u], q[i], qd[i], qdd[i]).f;
-                f[i] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).f;
+                f[i] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[d]).f;
             }
         }
     }
@@ -470,18 +508,22 @@ impl Robot {
     }
 
     /// The rows and columns of M that are not the multibody block of Eq. 3.39: the held body of
-    /// a robot on a stand, the bristle (Eq. 3.85-3.86), inductance (Eq. 3.91) and PID terms.
+    /// a robot on a stand, the series-elastic drives' inertia, the bristle (Eq. 3.85-3.86),
+    /// inductance (Eq. 3.91) and PID terms.
     fn write_state_mass(&self, qd: &[f64], qdd: &[f64], mass: &mut DMatrix<f64>) {
         let m = &*self.model;
         if m.options.stand {
             held_body_rows(mass, 1.0);
         }
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let d = m.drive_index(k);
             let load = self.outputs.contact[k / 3].normal_force;
+            if let Some(series) = &m.series {
+                mass[(d, d)] = series[k].drive_inertia;
+            }
             if let Some(b) = m.bristles {
-                mass[(j, b + k)] = m.friction[k].torque(qd[j], qd[b + k], qdd[b + k], load, self.outputs.motor_torque[k]).dtau_dzdot;
-                mass[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dzdot;
+                mass[(d, b + k)] = m.friction[k].torque(qd[d], qd[b + k], qdd[b + k], load, self.outputs.motor_torque[k]).dtau_dzdot;
+                mass[(b + k, b + k)] = m.friction[k].bristle_residual(qd[d], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dzdot;
             }
             if let Some(c) = m.currents {
                 mass[(c + k, c + k)] = m.motors[k].l;
@@ -536,6 +578,14 @@ impl System for Robot {
         }
         self.evaluate(q, qd, qdd);
         self.partial_velocities();
+        if self.model.series.is_some() {
+            // Series-elastic drives carry the rotors' reflected inertia (I_a n², 3e4 kg on a
+            // nut) that dominates a rigid joint's row of M: without it a leg's M is its links'
+            // alone, light and changing with the configuration (Newton on q'' with the one kept
+            // over 2 cm oscillates at any h), so it is taken at every Jacobian.
+            let inertial = self.inertial.as_mut().expect("taken above");
+            mbs::mass_matrix(&self.model.multibody, &self.data, &mut inertial.mass);
+        }
         let inertial = self.inertial.as_ref().expect("taken above");
         jac.m.view_mut((0, 0), (DOF, DOF)).copy_from(&inertial.mass);
         self.write_state_mass(qd, qdd, &mut jac.m);
@@ -569,63 +619,75 @@ impl System for Robot {
             dfn_dq[leg] = normal.transpose() * df_dq;
             dfn_dqd[leg] = normal.transpose() * df_dqd;
         }
+        // The motor and friction terms are in the rows and columns of the drive position d (the
+        // joint's own, or a series-elastic drive coordinate θ).
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let d = m.drive_index(k);
             let leg = k / 3;
             let load = self.outputs.contact[leg].normal_force;
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
-            // f_j contains −τ_m + τ_f(τ_m): a change of τ_m enters with the factor
+            // f_d contains −τ_m + τ_f(τ_m): a change of τ_m enters with the factor
             // −(1 − ∂τ_f/∂τ_m) (exactly −1 but for the efficiency law).
-            let t = m.friction[k].torque(qd[j], z, zdot, load, self.outputs.motor_torque[k]);
+            let t = m.friction[k].torque(qd[d], z, zdot, load, self.outputs.motor_torque[k]);
             let passed = 1.0 - t.dtau_dtau_m;
             let motor = &m.motors[k];
-            let dtau_m = if m.currents.is_some() { 0.0 } else { motor.joint_torque(motor.current(qd[j], 0.0).di_dqd).0 };
-            jac.ct[(j, j)] += t.dtau_dqd - passed * dtau_m;
+            let dtau_m = if m.currents.is_some() { 0.0 } else { motor.joint_torque(motor.current(qd[d], 0.0).di_dqd).0 };
+            jac.ct[(d, d)] += t.dtau_dqd - passed * dtau_m;
             if let Some(servos) = &m.servos {
-                // The servo's voltage u(q_d − q_j) drives the motor (f_j contains −τ_m(u)).
-                let du_dq = servos[k].voltage(self.references[k], q[j], m.options.supply_voltage).du_dq;
+                // The servo's voltage u(q_d − q) drives the motor (f_d contains −τ_m(u)).
+                let du_dq = servos[k].voltage(self.references[k], q[d], m.options.supply_voltage).du_dq;
                 match m.currents {
-                    Some(c) => jac.kt[(c + k, j)] = -du_dq,
-                    None => jac.kt[(j, j)] -= passed * motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * du_dq,
+                    Some(c) => jac.kt[(c + k, d)] = -du_dq,
+                    None => jac.kt[(d, d)] -= passed * motor.joint_torque(motor.current(qd[d], 0.0).di_du).0 * du_dq,
                 }
             }
             for col in 0..DOF {
-                jac.kt[(j, col)] += t.dtau_dload * dfn_dq[leg][col];
-                jac.ct[(j, col)] += t.dtau_dload * dfn_dqd[leg][col];
+                jac.kt[(d, col)] += t.dtau_dload * dfn_dq[leg][col];
+                jac.ct[(d, col)] += t.dtau_dload * dfn_dqd[leg][col];
             }
             if let Some(b) = m.bristles {
-                let r = m.friction[k].bristle_residual(qd[j], z, zdot, load).expect("LuGre has a bristle state");
-                jac.ct[(b + k, j)] = r.df_dqd;
+                let r = m.friction[k].bristle_residual(qd[d], z, zdot, load).expect("LuGre has a bristle state");
+                jac.ct[(b + k, d)] = r.df_dqd;
                 for col in 0..DOF {
                     jac.kt[(b + k, col)] += r.df_dload * dfn_dq[leg][col];
                     jac.ct[(b + k, col)] += r.df_dload * dfn_dqd[leg][col];
                 }
             }
             if let Some(c) = m.currents {
-                jac.ct[(c + k, j)] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).df_dqd;
+                jac.ct[(c + k, d)] = motor.current_residual(qd[c + k], qdd[c + k], qd[d], self.outputs.voltage[k]).df_dqd;
             }
             if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
                 let i = p + 2 * k + 1;
-                // ε = q_d − q_j.
-                jac.kt[(i, j)] = -pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).df_depsilon;
+                // ε = q_ref − q_d.
+                jac.kt[(i, d)] = -pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[d]).df_depsilon;
+            }
+            if let Some(series) = &m.series {
+                // f_j contains −τ_s and f_d contains +τ_s, τ_s = k (θ − q) + c (θ' − q').
+                let (j, spring) = (6 + k, series[k].spring);
+                for (row, sign) in [(j, -1.0), (d, 1.0)] {
+                    jac.kt[(row, d)] += sign * spring.stiffness;
+                    jac.kt[(row, j)] -= sign * spring.stiffness;
+                    jac.ct[(row, d)] += sign * spring.damping;
+                    jac.ct[(row, j)] -= sign * spring.damping;
+                }
             }
         }
         let m = &*self.model;
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let d = m.drive_index(k);
             let load = self.outputs.contact[k / 3].normal_force;
             let (z, zdot) = m.bristles.map_or((0.0, 0.0), |b| (qd[b + k], qdd[b + k]));
-            let t = m.friction[k].torque(qd[j], z, zdot, load, self.outputs.motor_torque[k]);
+            let t = m.friction[k].torque(qd[d], z, zdot, load, self.outputs.motor_torque[k]);
             let passed = 1.0 - t.dtau_dtau_m;
             if let Some(b) = m.bristles {
-                // f_j contains +τ_f (the joint force is τ_m − τ_f).
-                jac.ct[(j, b + k)] = t.dtau_dz;
-                jac.ct[(b + k, b + k)] = m.friction[k].bristle_residual(qd[j], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dz;
+                // f_d contains +τ_f (the drive's force is τ_m − τ_f).
+                jac.ct[(d, b + k)] = t.dtau_dz;
+                jac.ct[(b + k, b + k)] = m.friction[k].bristle_residual(qd[d], qd[b + k], qdd[b + k], load).expect("LuGre has a bristle state").df_dz;
             }
             if let Some(c) = m.currents {
-                jac.ct[(c + k, c + k)] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[j], self.outputs.voltage[k]).df_di;
-                // f_j contains −τ_m + τ_f(τ_m), τ_m = n k_t i.
-                jac.ct[(j, c + k)] = -passed * m.motors[k].joint_torque(1.0).1;
+                jac.ct[(c + k, c + k)] = m.motors[k].current_residual(qd[c + k], qdd[c + k], qd[d], self.outputs.voltage[k]).df_di;
+                // f_d contains −τ_m + τ_f(τ_m), τ_m = n k_t i.
+                jac.ct[(d, c + k)] = -passed * m.motors[k].joint_torque(1.0).1;
             }
             if let (Some(p), Some(pids)) = (m.pid, &m.pids) {
                 let (u, i) = (p + 2 * k, p + 2 * k + 1);
@@ -633,14 +695,14 @@ impl System for Robot {
                 jac.ct[(u, u)] = r.df_dqd_u;
                 jac.ct[(u, i)] = r.df_dqd_i;
                 jac.kt[(u, i)] = r.df_dq_i;
-                jac.ct[(i, i)] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[j]).df_dqd_i;
+                jac.ct[(i, i)] = pids[k].integral_residual(qd[i], qdd[i], self.references[k] - q[d]).df_dqd_i;
                 // The controller output q'_u drives the motor through the saturation.
                 let passes = if qd[u].abs() < m.options.supply_voltage { 1.0 } else { 0.0 };
                 match m.currents {
                     Some(c) => jac.ct[(c + k, u)] = -passes,
                     None => {
                         let motor = &m.motors[k];
-                        jac.ct[(j, u)] = -passed * motor.joint_torque(motor.current(qd[j], 0.0).di_du).0 * passes;
+                        jac.ct[(d, u)] = -passed * motor.joint_torque(motor.current(qd[d], 0.0).di_du).0 * passes;
                     }
                 }
             }
@@ -677,8 +739,9 @@ impl System for Robot {
         }
     }
 
-    /// The inputs enter only the rows of their own joint, at fixed (q, q', q''), affinely but
-    /// for the efficiency law's friction, which follows the motor torque:
+    /// The inputs enter only the rows of their own joint (its drive's, through a series-elastic
+    /// transmission), at fixed (q, q', q''), affinely but for the efficiency law's friction,
+    /// which follows the motor torque:
     /// a voltage (saturated at the supply; the limit switches were applied when it was
     /// commanded, [`Robot::command`]) through the current of Eq. 4.4 into the joint row
     /// (f_j contains −n k_t i) or, with inductance, into the current row of Eq. 3.91 (−u); a
@@ -692,7 +755,7 @@ impl System for Robot {
         df.fill(0.0);
         let m = &*self.model;
         for k in 0..JOINTS {
-            let j = 6 + k;
+            let d = m.drive_index(k);
             match (m.pid, &m.pids) {
                 (Some(p), Some(pids)) => {
                     let i = p + 2 * k + 1;
@@ -702,19 +765,19 @@ impl System for Robot {
                     let motor = &m.motors[k];
                     let supply = m.options.supply_voltage;
                     let (u, before) = match &m.servos {
-                        Some(servos) => (servos[k].voltage(self.references[k], q[j], supply).u, servos[k].voltage(previous[k], q[j], supply).u),
+                        Some(servos) => (servos[k].voltage(self.references[k], q[d], supply).u, servos[k].voltage(previous[k], q[d], supply).u),
                         None => (saturate(self.voltages[k], supply), saturate(previous[k], supply)),
                     };
                     let du = u - before;
                     match m.currents {
-                        Some(c) => df[c + k] = motor.current_residual(qd[c + k], qdd[c + k], qd[j], 0.0).df_du * du,
+                        Some(c) => df[c + k] = motor.current_residual(qd[c + k], qdd[c + k], qd[d], 0.0).df_du * du,
                         None => {
-                            // f_j contains −τ_m + τ_f(τ_m): the friction's change is exactly
+                            // f_d contains −τ_m + τ_f(τ_m): the friction's change is exactly
                             // zero but for the efficiency law, whose loss follows τ_m.
-                            let dtau_m = motor.joint_torque(motor.current(qd[j], 0.0).di_du * du).0;
-                            let tau_m = motor.joint_torque(motor.current(qd[j], u).i).0;
-                            let friction = |tau_m: f64| m.friction[k].torque(qd[j], 0.0, 0.0, 0.0, tau_m).tau;
-                            df[j] = -dtau_m + (friction(tau_m) - friction(tau_m - dtau_m));
+                            let dtau_m = motor.joint_torque(motor.current(qd[d], 0.0).di_du * du).0;
+                            let tau_m = motor.joint_torque(motor.current(qd[d], u).i).0;
+                            let friction = |tau_m: f64| m.friction[k].torque(qd[d], 0.0, 0.0, 0.0, tau_m).tau;
+                            df[d] = -dtau_m + (friction(tau_m) - friction(tau_m - dtau_m));
                         }
                     }
                 }

@@ -22,19 +22,22 @@ pub struct EnergyAccount {
     /// ∫ (R + R_bridge) i² dt per joint.
     pub joule: [f64; JOINTS],
     /// ∫ τ_f q' dt per joint: work done against friction (including the energy momentarily
-    /// stored in the LuGre bristles, see `bristle_energy`).
+    /// stored in the LuGre bristles, see `bristle_energy`), at the drive position (a series-elastic
+    /// drive's θ'), plus the work dissipated by a series spring's damper, ∫ c (θ' − q')² dt.
     pub friction_work: [f64; JOINTS],
-    /// ∫ τ_m q' dt per joint: mechanical work of the motor on its joint.
+    /// ∫ τ_m q' dt per joint: mechanical work of the motor on its drive.
     pub motor_work: [f64; JOINTS],
     /// ∫ −F·v dt per foot: work done by the feet on the ground and on the stand's loads
     /// (`model.foot_load_kg`), including the elastic energy stored in the ground, see
     /// `contact_energy`.
     pub contact_work: [f64; 6],
-    /// Stored energies at the current state: kinetic, potential (gravity), bristles ½ σ0 z²,
-    /// ground ∫ K δ^p_K dδ, inductances ½ L i².
+    /// Stored energies at the current state: kinetic (of the multibody model and of the
+    /// series-elastic drives, ½ J θ'²), potential (gravity), bristles ½ σ0 z², series springs
+    /// ½ k (θ − q)², ground ∫ K δ^p_K dδ, inductances ½ L i².
     pub kinetic: f64,
     pub potential: f64,
     pub bristle_energy: f64,
+    pub spring_energy: f64,
     pub contact_energy: f64,
     pub magnetic_energy: f64,
     powers: Option<Powers>,
@@ -55,17 +58,23 @@ impl EnergyAccount {
     fn accumulate(&mut self, robot: &Robot, state: &State) {
         let m = &*robot.model;
         let out = &robot.outputs;
-        let qd = state.qd.as_slice();
+        let (q, qd) = (state.q.as_slice(), state.qd.as_slice());
         let mut p = Powers { t: state.t, electrical: [0.0; JOINTS], joule: [0.0; JOINTS], friction: [0.0; JOINTS], motor: [0.0; JOINTS], contact: [0.0; 6] };
         self.bristle_energy = 0.0;
+        self.spring_energy = 0.0;
         self.magnetic_energy = 0.0;
         for k in 0..JOINTS {
-            let v = qd[6 + k];
+            let v = qd[m.drive_index(k)];
             let motor = &m.motors[k];
             p.electrical[k] = motor.electrical_power(out.voltage[k], out.current[k]);
             p.joule[k] = motor.joule_loss(out.current[k]);
             p.friction[k] = out.friction_torque[k] * v;
             p.motor[k] = out.motor_torque[k] * v;
+            if let Some(series) = &m.series {
+                let (d, j) = (m.drive_index(k), 6 + k);
+                p.friction[k] += series[k].spring.dissipation(qd[d] - qd[j]);
+                self.spring_energy += series[k].spring.energy(q[d] - q[j]);
+            }
             if let JointFriction::LuGre(law) = &m.friction[k].law {
                 self.bristle_energy += 0.5 * law.sigma_0 * out.bristle[k].powi(2);
             }
@@ -81,6 +90,9 @@ impl EnergyAccount {
         // them the kinetic and potential energies, are those accumulated last, at the same t.
         if self.powers.as_ref().is_none_or(|prev| prev.t != state.t) {
             self.kinetic = mbs::kinetic_energy(&m.multibody, robot.data());
+            if let Some(series) = &m.series {
+                self.kinetic += (0..JOINTS).map(|k| 0.5 * series[k].drive_inertia * qd[m.drive_index(k)].powi(2)).sum::<f64>();
+            }
             self.potential = mbs::potential_energy(&m.multibody, robot.data());
         }
         if let Some(prev) = &self.powers {
@@ -99,7 +111,8 @@ impl EnergyAccount {
     }
 
     /// Electrical energy in minus everything it should have become: Δ(kinetic + potential) +
-    /// Joule + friction work + contact work + Δ(magnetic energy). Zero up to integration error.
+    /// Joule + friction work + contact work + Δ(series springs' energy) + Δ(magnetic energy).
+    /// Zero up to integration error.
     pub fn balance_error(&self, initial: &EnergyAccount) -> f64 {
         let sum = |a: &[f64]| a.iter().sum::<f64>();
         sum(&self.electrical)
@@ -107,6 +120,7 @@ impl EnergyAccount {
             - sum(&self.joule)
             - sum(&self.friction_work)
             - sum(&self.contact_work)
+            - (self.spring_energy - initial.spring_energy)
             - (self.magnetic_energy - initial.magnetic_energy)
     }
 }
@@ -214,7 +228,7 @@ impl Plant for SimulatedRobot {
         let q = s.q.as_slice();
         Measurements {
             t: s.t,
-            positions: std::array::from_fn(|k| self.encoders[k].measure(q[6 + k])),
+            positions: std::array::from_fn(|k| self.encoders[k].measure(q[self.robot.model.drive_index(k)])),
             currents: self.current_sensors.sample(),
             supply_voltage: self.robot.model.options.supply_voltage,
             pose: self.navigation.then(|| BodyPose { position: nalgebra::Vector3::new(q[0], q[1], q[2]), yaw: q[3], pitch: q[4], roll: q[5] }),

@@ -315,7 +315,7 @@ impl RunStats {
             if cmd.voltages[k].abs() >= supply {
                 self.saturated += 1;
             }
-            let held = crate::physics::limit_switch(cmd.voltages[k], q[6 + k], &model.strokes[k]);
+            let held = crate::physics::limit_switch(cmd.voltages[k], q[model.drive_index(k)], &model.strokes[k]);
             if held == 0.0 && cmd.voltages[k] != 0.0 {
                 self.cuts += 1;
             }
@@ -342,6 +342,7 @@ pub(super) fn summarize(s: &Scenario, plant: &SimulatedRobot, stats: &RunStats, 
         + sum(&e.joule)
         + sum(&e.friction_work).abs()
         + sum(&e.contact_work).abs()
+        + (e.spring_energy - e0.spring_energy).abs()
         + (e.magnetic_energy - e0.magnetic_energy).abs();
     let rows = stats.rows;
     Summary {

@@ -66,7 +66,7 @@ impl Robot {
     pub(super) fn inertial_jacobian(&mut self, q: &[f64], qd: &[f64], qdd: &[f64]) -> InertialJacobian {
         self.evaluate(q, qd, qdd);
         let contact = self.outputs.contact.map(|c| c.force);
-        let joint: [f64; JOINTS] = std::array::from_fn(|k| self.outputs.motor_torque[k] - self.outputs.friction_torque[k]);
+        let joint: [f64; JOINTS] = self.outputs.joint_force;
         let scales = self.model.layout.scales.clone();
         let mut mass = zero_matrix(DOF, DOF);
         mbs::mass_matrix(&self.model.multibody, &self.data, &mut mass);

@@ -10,7 +10,7 @@ use crate::control::{Encoder, PositionServo};
 use crate::description::{JointFrictionParameters, PiGains, RobotDescription};
 use crate::hexapod::{LegDynamics, LegJoints, Mechanics, MechanicsParameters, PantographJoint, JOINTS};
 use crate::mbs::{self, BodyId};
-use crate::physics::{DcMotor, FrictionElement, JointFriction, LuGre, SteadyState};
+use crate::physics::{DcMotor, FrictionElement, JointFriction, LuGre, SeriesSpring, SteadyState};
 
 /// A robot's mechanism and drives, whatever its legs (the pantograph of the description file,
 /// serial legs): what [`super::RobotModel::assemble`] makes one residual system of.
@@ -34,14 +34,42 @@ pub struct RobotParts {
     /// Position servos driving the motors (their own loop, goal positions as inputs), or none:
     /// the motors take the master's voltages.
     pub servos: Option<[PositionServo; JOINTS]>,
+    /// Series-elastic transmissions (a spring between each gear output and its joint), or none:
+    /// rigid drives.
+    pub series: Option<[SeriesElastic; JOINTS]>,
+}
+
+/// The series-elastic transmission of one joint: its spring, and the inertia of the drive side
+/// (the motor, gear and nut, at the drive coordinate θ in joint units), the rotor's axial
+/// inertia reflected through the reduction, I_a n² (kg or kg m²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeriesElastic {
+    pub spring: SeriesSpring,
+    pub drive_inertia: f64,
 }
 
 impl RobotParts {
     /// The parts of a (pantograph) robot description: its 49-body mechanics (Eq. 3.51-3.71),
     /// the DC motors of Table 3.4 with the reductions of Table 3.1, the friction of Section 6.1,
     /// the strokes of Table 5.2 and the PI gains of Table 4.1.
+    ///
+    /// With series-elastic transmissions (`[series_elastic]`) the rotors turn with the drive
+    /// coordinates, not the joints: their axial inertia leaves the multibody model (a rotor
+    /// without it: its spin carries no inertia, Eq. 3.38) and becomes the drive side's, I_a n².
+    /// INTERPRETATION: the coupling of a rotor's spin with its carrier's rotation, I_a n θ'
+    /// (a·ω), is dropped with it (of order 1/n of the rotor's own energy: 6e-4 for q_r).
     pub fn from_description(d: &RobotDescription, options: &ModelOptions) -> Self {
-        let mechanics = Mechanics::new(&MechanicsParameters::from_description(d)).expect("a validated description builds a valid mechanics");
+        let mut parameters = MechanicsParameters::from_description(d);
+        let series = d.series_elastic.is_some().then(|| {
+            std::array::from_fn(|k| {
+                let joint = PantographJoint::ALL[k % 3];
+                SeriesElastic { spring: d.series_spring(joint).expect("[series_elastic] has every joint"), drive_inertia: parameters.rotor_axial * d.reduction(joint).powi(2) }
+            })
+        });
+        if series.is_some() {
+            parameters.rotor_axial = 0.0;
+        }
+        let mechanics = Mechanics::new(&parameters).expect("a validated description builds a valid mechanics");
         let motor = |joint: PantographJoint| DcMotor {
             r: d.motor.resistance_ohm,
             r_bridge: d.driver.series_resistance_ohm(),
@@ -64,6 +92,7 @@ impl RobotParts {
             pi_gains: std::array::from_fn(|k| d.pi_gains(PantographJoint::ALL[k % 3])),
             encoders: std::array::from_fn(|k| Encoder { counts_per_rev: d.controller.encoder_impulses_per_rev, n: d.reduction(PantographJoint::ALL[k % 3]) }),
             servos: None,
+            series,
         }
     }
 }

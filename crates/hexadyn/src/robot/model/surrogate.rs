@@ -69,7 +69,7 @@ pub(super) struct Surrogate {
     f: [f64; DOF],
     /// Position, velocity and ground proximity of each foot.
     feet: [Foot; 6],
-    /// Contact force on each foot and joint force τ_m − τ_f of each joint.
+    /// Contact force on each foot and joint force of each joint (τ_m − τ_f, or a series spring's).
     contact: [Vector3<f64>; 6],
     joint: [f64; JOINTS],
     /// The feet's J_foot, taken at the first surrogate evaluation (an evaluation whose Newton
@@ -92,7 +92,7 @@ impl Robot {
             f: array(f),
             feet,
             contact: o.contact.map(|c| c.force),
-            joint: std::array::from_fn(|k| o.motor_torque[k] - o.friction_torque[k]),
+            joint: o.joint_force,
             j_foot: None,
         }));
         true
@@ -139,7 +139,7 @@ impl Robot {
             j.subtract_transpose_times(&(self.outputs.contact[leg].force - base.contact[leg]), &mut rows);
         }
         for k in 0..JOINTS {
-            rows[6 + k] -= self.outputs.motor_torque[k] - self.outputs.friction_torque[k] - base.joint[k];
+            rows[6 + k] -= self.outputs.joint_force[k] - base.joint[k];
         }
         f[..DOF].copy_from_slice(rows.as_slice());
         self.write_state_rows(q, qd, qdd, f);
