@@ -685,6 +685,13 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                         leg.descent += landing_speed * o.dt;
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z -= leg.descent;
+                        if p.z > leg.foot.z + 0.5 * landing_speed * o.dt {
+                            // The virtual anchor is where the encoders put the foot in the
+                            // estimated pose; seen from the desired one, the landing may start
+                            // above the swing's height (the body below its desired height): a
+                            // commanded rise, not the ground's push.
+                            self.landing.raises(l);
+                        }
                         reaching_down |= p.z < -o.body_height - o.lift;
                         p
                     }
