@@ -531,15 +531,28 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             self.start(m);
         }
         let contact = self.landing.ground_contact(m);
+        let pushed = self.landing.pushed_up();
         let forces = self.landing.foot_forces();
         let settling = settling_time();
         let before = self.walk.body.as_ref().expect("started").pose;
         let estimated = estimated_pose(m, &before);
 
         // Landings detected: the support begins where the encoders put the foot (Section 7.4).
+        // Beyond the thesis (issue 37): so does a landing or swinging foot that the ground
+        // pushes up ([`LandingDetector::pushed_up`]). It carries the body: a landing foot the
+        // detection of Section 5.6.3 misses (its joint back-driven upwards) and a swinging foot
+        // that met the ground from above have landed where they are. A swinging foot stopped
+        // against its swing is the elevator reflex's ([`super::elevator`]); a foot whose
+        // reference rises (takeoff, the reflex's rise) is never pushed up.
         self.state.touchdowns = [false; 6];
         for l in 0..6 {
-            if self.walk.legs[l].phase == FootPhase::Landing && contact[l] {
+            let leg = &self.walk.legs[l];
+            let landed = match leg.phase {
+                FootPhase::Landing => contact[l] || pushed[l],
+                FootPhase::Swing => leg.rise_to.is_none() && pushed[l],
+                _ => false,
+            };
+            if self.working(l) && landed {
                 let measured = self.leg_frame(l, &estimated).apply(&self.legs_kinematics[l].foot(&joints_of(m, l)));
                 let leg = &mut self.walk.legs[l];
                 (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured, measured, 0.0);
@@ -603,6 +616,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                     FootPhase::Support => frame_desired.inverse().apply(&leg.anchor),
                     // Lifted at constant speed with the support's horizontal motion.
                     FootPhase::Takeoff => {
+                        self.landing.raises(l);
                         let ground = frame_desired.inverse().apply(&leg.anchor);
                         let lifted = ground + Vector3::z() * (landing_speed * leg.elapsed.min(o.takeoff_time));
                         let p = self.within_reach(l, lifted, ground.z, &leg.joints);
@@ -615,6 +629,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                     // height it aims at or as high as the leg reaches; then the swing goes on
                     // from there.
                     FootPhase::Swing if leg.rise_to.is_some() => {
+                        self.landing.raises(l);
                         let mut p = leg.foot;
                         let top = leg.rise_to.unwrap_or(p.z);
                         p.z = (p.z + landing_speed * o.dt).min(top);
@@ -644,6 +659,13 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                             self.state.elevations += 1;
                             back
                         } else {
+                            if self.state.reaching_down {
+                                // Beyond the thesis (issue 37): the body goes down to a landing
+                                // foot (see below); the swinging foot keeps its height above the
+                                // ground instead of going down with the body onto the next tread.
+                                leg.pep.z += landing_speed * o.dt;
+                                self.landing.raises(l);
+                            }
                             let v = (aep - leg.pep) / leg.swing_time;
                             let mut p = leg.foot + Vector3::new(v.x, v.y, 0.0) * o.dt;
                             p.z = leg.pep.z;
@@ -663,6 +685,13 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                         leg.descent += landing_speed * o.dt;
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z -= leg.descent;
+                        if p.z > leg.foot.z + 0.5 * landing_speed * o.dt {
+                            // The virtual anchor is where the encoders put the foot in the
+                            // estimated pose; seen from the desired one, the landing may start
+                            // above the swing's height (the body below its desired height): a
+                            // commanded rise, not the ground's push.
+                            self.landing.raises(l);
+                        }
                         reaching_down |= p.z < -o.body_height - o.lift;
                         p
                     }

@@ -28,6 +28,18 @@ pub trait LandingDetector: Send {
     /// `leg` starts its landing: a detector that waits for the signals to follow the motion
     /// starts waiting from here.
     fn landing_starts(&mut self, _leg: usize) {}
+
+    /// The feet pushed up by the ground at the last [`Self::ground_contact`]: the ground force
+    /// estimated above the threshold while the foot rises against its leg ([`MotorCurrent`]).
+    /// Beyond the thesis: the free gait reads it for the feet it lowers or holds (landing and
+    /// swing), whose rise only the ground explains. None by default.
+    fn pushed_up(&self) -> [bool; 6] {
+        [false; 6]
+    }
+
+    /// The foot reference of `leg` rises at this update (takeoff, elevator reflex): the foot's
+    /// rise is commanded, not a push of the ground, until its joints have come to rest.
+    fn raises(&mut self, _leg: usize) {}
 }
 
 /// The simulation mode of Section 7.7: the ground is detected when the true normal force on the
@@ -74,13 +86,31 @@ impl LandingDetector for NormalForce {
 /// once, the filtered current later (measured on the PhantomX: 4.9 N in the air against a 2.1 N
 /// threshold at the first instant of a landing); hence the wait counts from the landing's
 /// start ([`LandingDetector::landing_starts`]).
+///
+/// Beyond the thesis ([`LandingDetector::pushed_up`], issue 37): a foot is also pushed up when
+/// the estimated force reaches the threshold while the carrying joints slide the foot upwards,
+/// for the same settling time, unless its reference rose since its joints last came to rest
+/// ([`LandingDetector::raises`]: the end of a takeoff reads as up to 65 N while the joint slows
+/// down). The free gait lowers its landing feet and holds its swinging feet at their height: a
+/// leg whose foot goes up against such a reference is driven back by a force its motors do not
+/// hold, and the estimate of a sliding joint is the one of Section 5.6.2 whichever way it
+/// slides. Measured on a staircase down (6 cm risers, 4.5 cm
+/// lift): a landing foot held at the bottom of its reach while the body went down to it carried
+/// 142 N for 2 s, estimated at 64-80 N from the currents, its vertical joint sliding up (q̂_v' <
+/// 0), so never detected, and the body's weight went to a swinging foot (Section 5.6.3's test of
+/// the sign of q̂_v' keeps a lifting leg, which carries load, from reading as a landing).
 #[derive(Clone, Debug)]
 pub struct MotorCurrent<L> {
     pub detector: GroundDetector<L>,
     /// The detector's output of the last update.
     pub detections: [LegDetection; 6],
-    /// How long each foot has been lowered with its joints sliding in its landing (s).
+    /// How long each foot has moved one way with its carrying joints sliding (s): > 0 lowered
+    /// (in its landing, from its start), < 0 raised.
     sliding: [f64; 6],
+    /// The feet pushed up at the last update ([`LandingDetector::pushed_up`]).
+    pushed: [bool; 6],
+    /// The foot reference rose since the joints last came to rest ([`LandingDetector::raises`]).
+    raised: [bool; 6],
     /// Time the joint must have slid before a detection (s).
     settling: f64,
     dt: f64,
@@ -103,6 +133,8 @@ impl<L: GroundSensingLeg> MotorCurrent<L> {
             detector: GroundDetector::new(robot, legs, dt, threshold),
             detections: Default::default(),
             sliding: [0.0; 6],
+            pushed: [false; 6],
+            raised: [false; 6],
             settling: settling_time(),
             dt,
         }
@@ -112,11 +144,23 @@ impl<L: GroundSensingLeg> MotorCurrent<L> {
 impl<L: GroundSensingLeg + Send> LandingDetector for MotorCurrent<L> {
     fn ground_contact(&mut self, m: &Measurements) -> [bool; 6] {
         self.detections = self.detector.update(m);
-        std::array::from_fn(|l| {
+        let settled = self.settling - 0.5 * self.dt;
+        for l in 0..6 {
             let d = self.detections[l];
-            self.sliding[l] = if d.sliding && d.lowering > 0.0 { self.sliding[l] + self.dt } else { 0.0 };
-            d.detected && self.sliding[l] >= self.settling - 0.5 * self.dt
-        })
+            let way = if d.lowering > 0.0 { 1.0 } else { -1.0 };
+            self.sliding[l] = if !d.sliding || d.lowering == 0.0 { 0.0 } else if self.sliding[l] * way >= 0.0 { self.sliding[l] + way * self.dt } else { way * self.dt };
+            self.raised[l] &= d.sliding;
+            self.pushed[l] = !self.raised[l] && self.sliding[l] <= -settled && d.force >= self.detector.threshold;
+        }
+        std::array::from_fn(|l| self.detections[l].detected && self.sliding[l] >= settled)
+    }
+
+    fn pushed_up(&self) -> [bool; 6] {
+        self.pushed
+    }
+
+    fn raises(&mut self, leg: usize) {
+        self.raised[leg] = true;
     }
 
     fn foot_forces(&self) -> Option<[Option<Vector3<f64>>; 6]> {
@@ -143,15 +187,24 @@ mod tests {
     /// the motor current `current` (A) of their vertical joints, the other joints still and
     /// unpowered, the simulated foot forces `forces`. Returns the detections.
     fn drive(d: &mut MotorCurrent<LegKinematics>, dt: f64, n: usize, qd_v: f64, current: f64, forces: Option<[f64; 6]>) -> Vec<[bool; 6]> {
+        drive_raised(d, dt, n, qd_v, current, forces, 0).into_iter().map(|(contact, _)| contact).collect()
+    }
+
+    /// [`drive`] with the foot references raised ([`LandingDetector::raises`]) over the first
+    /// `raised` periods. Returns the detections and the feet pushed up.
+    fn drive_raised(d: &mut MotorCurrent<LegKinematics>, dt: f64, n: usize, qd_v: f64, current: f64, forces: Option<[f64; 6]>, raised: usize) -> Vec<([bool; 6], [bool; 6])> {
         let mut m = Measurements { supply_voltage: 12.0, foot_normal_forces: forces, ..Default::default() };
         (0..n)
             .map(|k| {
                 for l in 0..6 {
                     m.positions[3 * l..3 * l + 3].copy_from_slice(&[0.0, 0.05 + qd_v * k as f64 * dt, 0.03]);
                     m.currents[3 * l + 1] = current;
+                    if k < raised {
+                        d.raises(l);
+                    }
                 }
                 m.t = k as f64 * dt;
-                d.ground_contact(&m)
+                (d.ground_contact(&m), d.pushed_up())
             })
             .collect()
     }
@@ -218,6 +271,28 @@ mod tests {
         let first = out.iter().position(|c| c[0]).unwrap();
         let settling = settling_time();
         assert!((first as f64 * dt - settling).abs() < 2.0 * dt, "first detection after {} s", first as f64 * dt);
+    }
+
+    /// Beyond the thesis: a foot going up (q_v' < 0) under three times the threshold is pushed
+    /// up once its joint has slid for the settling time, never detected as a landing (Section
+    /// 5.6.3); the same motion in the air, or commanded (its reference raised, and the joint
+    /// never at rest since), is no push.
+    #[test]
+    fn motor_current_sees_a_foot_pushed_up_against_its_reference() {
+        let robot = RobotDescription::amru5();
+        let dt = robot.controller.period_s;
+        let n = (2.0 / dt) as usize;
+        let up = -0.005;
+        let loaded = balancing_current(&robot, 0.045, up, 3.0 * THESIS_CURRENT_THRESHOLD);
+        let out = drive_raised(&mut amru5_detector(&robot, dt), dt, n, up, loaded, None, 0);
+        assert!(out.iter().all(|(contact, _)| contact.iter().all(|&c| !c)));
+        let first = out.iter().position(|(_, pushed)| pushed[0]).expect("pushed up");
+        assert!((first as f64 * dt - settling_time()).abs() < 2.0 * dt, "pushed up after {} s", first as f64 * dt);
+        assert!(out[first..].iter().all(|(_, pushed)| pushed.iter().all(|&p| p)));
+        let air = balancing_current(&robot, 0.045, up, 0.0);
+        assert!(drive_raised(&mut amru5_detector(&robot, dt), dt, n, up, air, None, 0).iter().all(|(_, pushed)| pushed.iter().all(|&p| !p)));
+        let commanded = drive_raised(&mut amru5_detector(&robot, dt), dt, n, up, loaded, None, n / 2);
+        assert!(commanded.iter().all(|(_, pushed)| pushed.iter().all(|&p| !p)));
     }
 
     #[test]
