@@ -40,6 +40,11 @@ use crate::spatial::Htm;
 /// once (lowest margin, Rule 3) and keeps a neighbour at its boundary deadlocked. 1 cm.
 pub const AEP_SECURITY: f64 = 0.01;
 
+/// The fastest a landing foot approaches the ground (m/s): 3 cm/s, the foot speed at which
+/// Section 5.6.3 validated the detection from the motor currents (the Table 5.6 sawtooth, 5 mm/s
+/// of q_v; docs/ground-detection.md). INTERPRETATION (beyond the thesis, issue 37).
+pub const APPROACH_SPEED_M_S: f64 = 0.03;
+
 /// Room (m) the support feet keep below the top of their reach when the body goes down after a
 /// landing foot at the bottom of its reach.
 ///
@@ -534,6 +539,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         let pushed = self.landing.pushed_up();
         let forces = self.landing.foot_forces();
         let settling = settling_time();
+        let lag = self.landing.lag_s();
         let before = self.walk.body.as_ref().expect("started").pose;
         let estimated = estimated_pose(m, &before);
 
@@ -608,6 +614,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             let c = self.workspaces[l].centre_at(-o.body_height);
             let v_c = centre_velocity(&self.legs_kinematics[l], &c, &frame_desired, &desired, &h);
             leg.elapsed += o.dt;
+            let mut descent_speed = landing_speed;
             leg.foot = if !self.working(l) {
                 self.held_up.expect("found for the failed leg")
             } else {
@@ -680,9 +687,21 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                             p
                         }
                     }
-                    // Down at constant speed until the ground is detected.
+                    // Down at constant speed until the ground is detected. INTERPRETATION
+                    // (beyond the thesis, issue 37): for a detector that lags the ground force
+                    // (LandingDetector::lag_s: the settling time of the filtered currents; none
+                    // for the simulated normal force), within the distance the landing speed
+                    // covers in that lag above the posture's ground level (z = −body height),
+                    // and below it, at most APPROACH_SPEED_M_S: the foot
+                    // presses on for that time before its landing is detected, and at the
+                    // landing speed of the thesis' 10.5 cm lift (10.5 cm/s) it pushed the body
+                    // up by a centimetre or more, unloading the other feet (docs/benchmarks.md).
                     FootPhase::Landing => {
-                        leg.descent += landing_speed * o.dt;
+                        let above = frame_desired.inverse().apply(&leg.anchor).z - leg.descent + o.body_height;
+                        if lag > 0.0 && above <= landing_speed * lag {
+                            descent_speed = landing_speed.min(APPROACH_SPEED_M_S);
+                        }
+                        leg.descent += descent_speed * o.dt;
                         let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z -= leg.descent;
                         if p.z > leg.foot.z + 0.5 * landing_speed * o.dt {
@@ -707,8 +726,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             if self.working(l) && leg.phase == FootPhase::Landing && leg.foot.z < -o.body_height && !ik.is_reached() {
                 // The landing foot at the bottom of its reach: it stays there while the body goes
                 // down (see above).
-                leg.descent -= landing_speed * o.dt;
-                leg.foot.z += landing_speed * o.dt;
+                leg.descent -= descent_speed * o.dt;
+                leg.foot.z += descent_speed * o.dt;
                 ik = self.legs_kinematics[l].inverse(&leg.foot, &leg.joints).expect("finite foot reference");
                 reaching_down = true;
             }

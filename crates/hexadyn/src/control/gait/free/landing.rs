@@ -40,6 +40,13 @@ pub trait LandingDetector: Send {
     /// The foot reference of `leg` rises at this update (takeoff, elevator reflex): the foot's
     /// rise is commanded, not a push of the ground, until its joints have come to rest.
     fn raises(&mut self, _leg: usize) {}
+
+    /// How long (s) the detector's signals lag the ground force: the time a landing foot
+    /// presses on before its landing is detected. 0 for a detector that reads the force
+    /// itself ([`NormalForce`]).
+    fn lag_s(&self) -> f64 {
+        0.0
+    }
 }
 
 /// The simulation mode of Section 7.7: the ground is detected when the true normal force on the
@@ -169,6 +176,11 @@ impl<L: GroundSensingLeg + Send> LandingDetector for MotorCurrent<L> {
 
     fn landing_starts(&mut self, leg: usize) {
         self.sliding[leg] = 0.0;
+    }
+
+    /// The settling time of the 3 Hz filter of the currents the detection waits for.
+    fn lag_s(&self) -> f64 {
+        self.settling
     }
 }
 
