@@ -28,13 +28,15 @@
 //!
 //! - [`FlatGround`], [`Slope`]: planes (analytic);
 //! - [`Step`]: two horizontal half planes joined by a vertical face (analytic closest point);
-//! - [`MeshTerrain`]: a triangle mesh (parry3d-f64's `TriMesh` with its BVH and the
-//!   angle-weighted pseudo-normals of its edges and vertices), from a PLY file ([`ply`]);
+//! - [`MeshTerrain`]: a triangle mesh (its faces found through a grid over the ground, each
+//!   face's closest point by parry3d-f64's `Triangle`, the angle-weighted pseudo-normals of its
+//!   edges and vertices computed from the faces around them), from a PLY file ([`ply`]);
 //! - [`Heightfield`]: heights on a regular grid, its height under a point by the cell's triangle
 //!   and its contact through the mesh of those triangles;
 //! - [`generate`]: the seeded terrains the shipped scenarios use (a step, a ramp, rough ground);
 //! - [`classes`]: terrain classes (steps, slopes, rough ground by size) drawn from seeds.
 
+mod face_grid;
 mod heightfield;
 mod mesh;
 mod step;

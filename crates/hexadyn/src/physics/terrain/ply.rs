@@ -10,12 +10,13 @@
 //! alone (24 bytes a vertex, 16 a triangle with the number of its face); the counts the header
 //! declares are checked against the file's size and against [`MAX_MESH_VERTICES`] and
 //! [`MAX_MESH_TRIANGLES`] before anything is read, so that a file declaring more than it holds
-//! or than the bounds is refused at once. The peak of loading a terrain is parry's building of
-//! its mesh ([`MeshTerrain`]: a BVH, the pseudo-normals of the edges and vertices, hash maps
-//! while it builds them): 446 bytes per triangle measured on grids of 2 and 4 million
-//! triangles (2 triangles a vertex; 2026-11-28, 2-core Linux container, commit e92dd69),
-//! so at most about 1.8 GB at the bounds; a file of vertices without faces takes 48 bytes a
-//! vertex.
+//! or than the bounds is refused at once. The terrain then keeps its merged vertices, faces,
+//! the faces around each vertex and a grid of the faces over the ground ([`MeshTerrain`]):
+//! 56 bytes a triangle at the peak of the load, 51 kept, on a binary PLY of 2 million
+//! triangles (2 triangles a vertex, 19 bytes a triangle of vertex and face data in the file:
+//! 2.9 times the file's data; `benches/src/bin/terrain.rs`, 2026-11-29, 2-core AMD EPYC
+//! container), so at most about 230 MB at the bounds; a file of vertices without faces takes
+//! 48 bytes a vertex.
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
