@@ -692,17 +692,17 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                     // (LandingDetector::lag_s: the settling time of the filtered currents; none
                     // for the simulated normal force), within the distance the landing speed
                     // covers in that lag above the posture's ground level (z = −body height),
-                    // and below it, at most APPROACH_SPEED_M_S: the foot
-                    // presses on for that time before its landing is detected, and at the
-                    // landing speed of the thesis' 10.5 cm lift (10.5 cm/s) it pushed the body
-                    // up by a centimetre or more, unloading the other feet (docs/benchmarks.md).
+                    // and below it, at most APPROACH_SPEED_M_S: the foot presses on for that
+                    // time before its landing is detected, and at the landing speed of the
+                    // thesis' 10.5 cm lift (10.5 cm/s) it pushed the body up by a centimetre or
+                    // more, unloading the other feet (docs/benchmarks.md).
                     FootPhase::Landing => {
-                        let above = frame_desired.inverse().apply(&leg.anchor).z - leg.descent + o.body_height;
+                        let mut p = frame_desired.inverse().apply(&leg.anchor);
+                        let above = p.z - leg.descent + o.body_height;
                         if lag > 0.0 && above <= landing_speed * lag {
                             descent_speed = landing_speed.min(APPROACH_SPEED_M_S);
                         }
                         leg.descent += descent_speed * o.dt;
-                        let mut p = frame_desired.inverse().apply(&leg.anchor);
                         p.z -= leg.descent;
                         if p.z > leg.foot.z + 0.5 * landing_speed * o.dt {
                             // The virtual anchor is where the encoders put the foot in the
