@@ -115,6 +115,30 @@ fn table_5_7_experiment_on_serial_legs() {
     }
 }
 
+/// The reference of issue 37's 15 % target: an ideal foot sensor (`stop_on = "foot_force"`, the
+/// simulated normal force read at the 100 Hz control instants) on leg 0, one trial per
+/// threshold. It stops at the first instant the force has reached the threshold, so the true
+/// force exceeds it by less than one control period's rise; at the Table 5.6 speed on the
+/// Table 3.3 ground that rise is about 8.4 N, more than 15 % of 40 N: a detector that waits
+/// for the threshold, however little it lags, stops more than 15 % late at 40 N on this ground
+/// (docs/ground-detection.md); 50 and 60 N are within. Measured 2026-11-29: +17.1 %, +10.7 %,
+/// +6.5 %.
+#[test]
+fn an_ideal_foot_sensor_stops_within_one_control_periods_rise() {
+    let s = scenario(&[("legs = [0, 1, 2, 3, 4, 5]", "legs = [0]"), ("trials = 4", "trials = 1"), ("duration_s = 606.0", "duration_s = 29.0"), ("period_s = 8.0", "period_s = 8.0\nstop_on = \"foot_force\"")]);
+    let r = run_scenario(&s, |_| {}).unwrap();
+    let (t, f) = (r.series.values("t").unwrap(), r.series.values("Fn[0]").unwrap());
+    let stops: Vec<usize> = (0..r.series.len()).filter(|&k| r.series.values("gd_stop").unwrap()[k] == 1.0).collect();
+    assert_eq!(stops.len(), 3);
+    for (&k, threshold) in stops.iter().zip([40.0, 50.0, 60.0]) {
+        let error = (f[k] - threshold) / threshold;
+        eprintln!("ideal foot sensor, {threshold} N: {:.1} N at t = {:.2} s ({:+.1} %), {:.1} N one control period before", f[k], t[k], 100.0 * error, f[k - 1]);
+        // The first instant at or above the threshold.
+        assert!(f[k] >= threshold && f[k - 1] < threshold, "{threshold} N: {} then {} N", f[k - 1], f[k]);
+        assert_eq!(error > 0.15, threshold == 40.0, "{threshold} N: {:+.1} %", 100.0 * error);
+    }
+}
+
 /// Issue 11's target: with the model's own friction the true force at detection is within
 /// 15 % of the threshold. On this model the true force at detection is 1.8-2.0 times the
 /// threshold: the foot meets the stiff ground (K_gnd = 1e6 N/m^1.5, Table 3.3) at 3 cm/s and the

@@ -231,6 +231,16 @@ fn no_slave_no_run() {
     assert!(e.to_string().contains("timing.period_s"), "{e}");
 }
 
+/// The robot has no foot sensors: a ground detection experiment stopped by the simulated foot
+/// force is refused before anything is sent, naming the field.
+#[test]
+fn an_ideal_foot_sensor_is_refused_on_the_robot() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../python/hexadyn/scenarios/ground_detection.toml");
+    let s = Scenario::from_file_with(path, &[Override { field: "ground_detection.stop_on".into(), value: toml::Value::String("foot_force".into()) }]).expect("an ideal foot sensor in simulation");
+    let e = check(&s, &LinkConfig::loopback(0)).expect_err("no foot sensors on the robot");
+    assert!(e.to_string().contains("ground_detection.stop_on") && e.to_string().contains("\"estimate\""), "{e}");
+}
+
 /// The final body position of the simulation and the emulated robot's distance to it (m).
 fn distance_to_simulation(s: &Scenario, report: &EmulatorReport) -> (f64, [f64; 3]) {
     let direct = run_scenario(s, |_| {}).expect("simulation");

@@ -97,6 +97,14 @@ fn a_misspelt_table_is_an_unknown_table() {
     assert!(s.contains("unknown table"), "{s}");
 }
 
+/// `ground_detection.stop_on` is one of its two words; anything else is named with them.
+#[test]
+fn an_unknown_stop_of_the_ground_experiment_is_named() {
+    let s = rejected(&with("ground_detection", "period_s = 8.0", "period_s = 8.0\nstop_on = \"contact\""), "ground_detection.stop_on");
+    assert!(s.contains("contact") && s.contains("estimate") && s.contains("foot_force"), "{s}");
+    assert!(parse(&with("ground_detection", "period_s = 8.0", "period_s = 8.0\nstop_on = \"foot_force\"")).is_ok());
+}
+
 #[test]
 fn a_duplicate_key_is_named() {
     for (text, key) in [(with("stand_six_legs", "duration_s = 10.0", "duration_s = 10.0\nduration_s = 1.0"), "duration_s"), (with("stand_six_legs", "[control]", "[model]\n[control]"), "model")] {

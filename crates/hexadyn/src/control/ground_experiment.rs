@@ -87,6 +87,10 @@ pub struct GroundExperiment {
     /// Sawtooth period P (s), Table 5.6.
     #[serde(default = "table_5_6_period", rename = "period_s")]
     pub period: f64,
+    /// What stops the leg: the ground force estimated from the motor currents (the thesis'
+    /// experiment) or the simulated foot force (an ideal foot sensor).
+    #[serde(default)]
+    pub stop_on: StopOn,
     /// Whether the master adds its friction feed-forward to the servo goals (as
     /// `gait.friction_feedforward`; position servos only).
     #[serde(default)]
@@ -95,6 +99,22 @@ pub struct GroundExperiment {
     /// file describes it).
     #[serde(skip)]
     pub feedforward: Option<FrictionFeedForward>,
+}
+
+/// What stops the tested leg in the experiment.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopOn {
+    /// The [`GroundDetector`] of Section 5.6.3: the vertical ground force estimated from the
+    /// encoders and the motor currents reaches the threshold.
+    #[default]
+    Estimate,
+    /// Beyond the thesis: the simulated normal force on the foot
+    /// ([`Measurements::foot_normal_forces`]) reaches the threshold, read at the control
+    /// instants as an ideal foot sensor would be: the reference against which an estimator's
+    /// stops are measured (the force still rises between two instants; docs/ground-detection.md).
+    /// Simulation only: the real robot has no foot sensors.
+    FootForce,
 }
 
 fn all_legs() -> Vec<usize> {
@@ -115,7 +135,7 @@ fn table_5_6_period() -> f64 {
 
 impl Default for GroundExperiment {
     fn default() -> Self {
-        GroundExperiment { legs: all_legs(), thresholds: table_5_7_thresholds(), trials: 4, amplitude: table_5_6_amplitude(), period: table_5_6_period(), friction_feedforward: false, feedforward: None }
+        GroundExperiment { legs: all_legs(), thresholds: table_5_7_thresholds(), trials: 4, amplitude: table_5_6_amplitude(), period: table_5_6_period(), stop_on: StopOn::Estimate, friction_feedforward: false, feedforward: None }
     }
 }
 
@@ -225,6 +245,16 @@ impl<L: LoweredLeg + Clone> GroundExperimentController<L> {
     }
 }
 
+impl<L> GroundExperimentController<L> {
+    /// Whether leg `l` stops at this instant ([`StopOn`]), the detector's `detections` of it.
+    fn stops(&self, l: usize, threshold: f64, detections: &[LegDetection; LEG_COUNT], m: &Measurements) -> bool {
+        match self.experiment.stop_on {
+            StopOn::Estimate => detections[l].detected,
+            StopOn::FootForce => m.foot_normal_forces.is_some_and(|f| f[l] >= threshold),
+        }
+    }
+}
+
 impl<L: LoweredLeg> Controller for GroundExperimentController<L> {
     fn update(&mut self, m: &Measurements) -> Command {
         let detections = self.detector.update(m);
@@ -247,7 +277,7 @@ impl<L: LoweredLeg> Controller for GroundExperimentController<L> {
                         // Resume once the reference rises above the stop point.
                         Some(s) if phase.reference < s => self.hold = None,
                         Some(_) => {}
-                        None if descending && settled && detections[l].detected => {
+                        None if descending && settled && self.stops(l, threshold, &detections, m) => {
                             self.hold = Some(self.legs[l].descent(&leg_joints(&m.positions, l)));
                             let stop = Stop { t: m.t, leg: l, threshold, trial, estimate: detections[l].force };
                             st.stop = Some(stop);

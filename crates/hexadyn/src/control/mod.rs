@@ -18,7 +18,7 @@ mod torque_estimation;
 pub use interface::{BodyPose, Command, Controller, Measurements, Plant};
 pub use joint_control::{joint_command, joint_pis, pi_command, JointMotion, JointPiController, JointReferences, ReferenceFeed, ReferenceSource, Unpowered};
 pub use ground_detection::{alpha, GroundDetector, GroundSensingLeg, LegDetection};
-pub use ground_experiment::{GroundExperiment, GroundExperimentController, GroundExperimentState, Stop, REST_S};
+pub use ground_experiment::{GroundExperiment, GroundExperimentController, GroundExperimentState, Stop, StopOn, REST_S};
 pub use low_pass::{settling_time, DigitalLowPass, DIGITAL_CUTOFF_HZ, SETTLING_TIME_CONSTANTS};
 pub use torque_estimation::{TorqueEstimate, TorqueEstimator};
 pub use pi::{ContinuousPid, DigitalPi, Encoder, PidIntegralResidual, PidVoltageResidual};

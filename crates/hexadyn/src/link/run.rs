@@ -46,7 +46,7 @@ use super::drive::{Drive, JointScale};
 use super::master::{LinkEvent, LinkStats, SafetyStop};
 use super::protocol::{Duty, Goal, Protocol, COUNT_MAX, COUNT_MIN, GOAL_MAX};
 use super::{LinkError, UdpPlant};
-use crate::control::{Command, Measurements};
+use crate::control::{Command, Measurements, StopOn};
 use crate::description::serial::DriveControl;
 use crate::description::Robot;
 use crate::hexapod::{LegJoints, JOINTS};
@@ -122,6 +122,9 @@ pub fn check(s: &Scenario, config: &LinkConfig) -> Result<Protocol, LinkError> {
             s.period(),
             s.period()
         )));
+    }
+    if s.ground_detection.as_ref().is_some_and(|g| g.stop_on == StopOn::FootForce) {
+        return Err(LinkError::Mismatch(format!("{}: ground_detection.stop_on = \"foot_force\", but the robot has no foot force sensors; allowed: stop_on = \"estimate\" (the ground force estimated from the motor currents)", s.origin)));
     }
     if s.gait.as_ref().is_some_and(|g| g.navigation) {
         return Err(LinkError::Mismatch(format!("{}: gait.navigation = true, but the robot has no navigation system; allowed: a scenario with navigation = false", s.origin)));
