@@ -1,4 +1,5 @@
-//! A terrain given as a triangle mesh, queried through parry3d-f64.
+//! A terrain given as a triangle mesh: its faces found through a grid over the ground
+//! (`face_grid.rs`), each face queried through parry3d-f64's `Triangle`.
 
 use nalgebra::{Matrix3, Vector3};
 use parry3d_f64::bounding_volume::Aabb;
