@@ -191,12 +191,13 @@ impl MeshTerrain {
         let mut best_distance = f64::INFINITY;
         self.grid.rings([c.x, c.y, c.z], |faces| {
             for &face in faces {
+                let t = self.triangle(face);
                 // A face whose box is farther than the closest point so far cannot be closer (the
                 // relative slack covers the rounding of both distances).
-                if box_distance_squared(&self.triangle(face).local_aabb(), c) > best_distance * best_distance * (1.0 + 1e-9) {
+                if box_distance_squared(&t.local_aabb(), c) > best_distance * best_distance * (1.0 + 1e-9) {
                     continue;
                 }
-                let (projection, location) = self.triangle(face).project_local_point_and_get_location(c, false);
+                let (projection, location) = t.project_local_point_and_get_location(c, false);
                 let distance = (projection.point - c).length();
                 if distance < best_distance {
                     best = Some((face, projection.point, location));
@@ -432,7 +433,8 @@ impl Vicinity {
         let mut best: Option<(usize, PVec, TrianglePointLocation)> = None;
         let mut best_distance = f64::MAX;
         // Two faces at exactly the closest distance (the closest point on their common edge):
-        // the mesh's search (`MeshTerrain::closest`) keeps the first it visits, so the vicinity leaves the choice to it.
+        // the mesh's search (`MeshTerrain::closest`) keeps the first it visits, so the vicinity
+        // leaves the choice to it.
         let mut tie = false;
         self.projected.clear();
         for (k, (face, aabb)) in self.faces.iter().enumerate() {
