@@ -66,6 +66,20 @@ impl LegDynamics {
         std::array::from_fn(|k| f[joint_index(0, 0) + k])
     }
 
+    /// The centre of mass of the whole robot in the body frame with the joints at `q` (joint
+    /// k = 3 leg + j): Σ m_i p_i / Σ m_i over the bodies of the model, whose frames end at their
+    /// centres of gravity (Eq. 3.23), the body frame at the origin.
+    pub fn centre_of_mass(&self, data: &mut Data, q: &[f64; JOINTS]) -> Vector3<f64> {
+        let mut x = [0.0; DOF];
+        x[joint_index(0, 0)..].copy_from_slice(q);
+        relative_kinematics(&self.model, data, &x, &[0.0; DOF]);
+        let (weighted, mass) = (0..self.model.bodies.len()).map(BodyId).fold((Vector3::zeros(), 0.0), |(w, m), b| {
+            let mass = self.model.body_mass(b);
+            (w + data.position(b) * mass, m + mass)
+        });
+        weighted / mass
+    }
+
     /// [`Self::joint_torques`] of one `leg` on a still, level body, the force `foot_force`
     /// (global frame, N) on its foot. Every leg is put in the same configuration (a closed
     /// pantograph needs a valid one), which does not change the rows of `leg`: with the body
@@ -135,6 +149,40 @@ mod tests {
         }
         // Section 5.2.1: no gravity torque on q_r of a level body.
         assert!(tau[0].abs() < 1e-9);
+    }
+
+    /// The centre of mass against two independent facts: the legs are equally distributed
+    /// around the body (Section 2.3, Fig. 2.14), so with every leg at the same joints it lies
+    /// on the body's z axis; and at rest the gravity torque of every joint is M g ∂z_G/∂q
+    /// (virtual work), which the residual gives without the centre of mass. One leg swung
+    /// outwards moves it towards that leg by that leg's share of the mass.
+    #[test]
+    fn centre_of_mass_is_on_the_axis_of_a_symmetric_stance_and_its_height_gives_the_gravity_torques() {
+        let (mech, dynamics, mut data) = amru5();
+        let q: [f64; JOINTS] = std::array::from_fn(|k| [0.1, 0.055, 0.03][k % 3]);
+        let g = dynamics.centre_of_mass(&mut data, &q);
+        assert!(g.xy().norm() < 1e-12, "symmetric stance: {g}");
+        let mass = mech.model.total_mass();
+        let asym: [f64; JOINTS] = std::array::from_fn(|k| [0.1, 0.055, 0.03][k % 3] + 0.0005 * k as f64);
+        let tau = dynamics.joint_torques(&mut data, StillBody::default(), &asym, &[0.0; JOINTS], &[0.0; JOINTS], None);
+        for k in 0..JOINTS {
+            let h = 1e-6;
+            let (mut qp, mut qm) = (asym, asym);
+            qp[k] += h;
+            qm[k] -= h;
+            let dz = (dynamics.centre_of_mass(&mut data, &qp).z - dynamics.centre_of_mass(&mut data, &qm).z) / (2.0 * h);
+            let expected = mass * STANDARD_GRAVITY * dz;
+            assert!((tau[k] - expected).abs() <= 1e-6 * expected.abs().max(1.0), "joint {k}: {} vs M g dz_G/dq {expected}", tau[k]);
+        }
+        // q_h of leg 0 (front left, Fig. 2.14) out by 5 cm: the centre of mass moves forwards
+        // and to the left, by less than the leg's share of the mass times the foot's motion
+        // (about 6 q_h, the pantograph's amplification).
+        let mut out = q;
+        out[joint_index(0, 2) - joint_index(0, 0)] += 0.05;
+        let moved = dynamics.centre_of_mass(&mut data, &out) - g;
+        let leg = &mech.legs[0];
+        let leg_mass: f64 = leg.links.iter().chain(leg.rotors.iter()).map(|&b| mech.model.body_mass(b)).sum();
+        assert!(moved.x > 1e-3 && moved.y > 1e-4 && moved.norm() < 6.0 * 0.05 * leg_mass / mass, "{moved}");
     }
 
     /// A vertical force F on the foot needs the torques −(∂z_foot/∂q) F: about 6 F on q_v

@@ -287,10 +287,11 @@ impl GaitScenario {
         }
     }
 
-    /// The free gait on `legs`, publishing its state, with the master's friction feed-forward.
+    /// The free gait on `legs`, publishing its state, with the master's friction feed-forward
+    /// and the robot's masses (the centre of mass of its stability check).
     fn published<L: Leg + GroundSensingLeg + Clone + Send + 'static>(&self, free: &FreeGaitSpec, legs: &[L; 6], pis: [DigitalPi; JOINTS], robot: &Robot) -> (Box<dyn Controller>, Rc<RefCell<GaitState>>) {
         let controller = FreeGaitController::new(free.options.clone(), legs.clone(), self.workspaces, pis, self.heading.source(), free.landing.detector(robot, legs, self.options.dt));
-        let (c, state) = PublishedFreeGait::new(controller.with_friction_feedforward(self.friction_feedforward.clone()));
+        let (c, state) = PublishedFreeGait::new(controller.with_friction_feedforward(self.friction_feedforward.clone()).with_masses(robot.leg_dynamics()));
         (Box::new(c), state)
     }
 
