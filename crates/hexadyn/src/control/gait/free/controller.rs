@@ -502,8 +502,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// check takes its centre of mass from it.
     fn centre_of_mass(&mut self, m: &Measurements, estimated: &Htm) -> Vector3<f64> {
         let Some((data, dynamics)) = self.masses.as_mut() else { return estimated.translation };
-        let q: [f64; JOINTS] = std::array::from_fn(|k| m.positions[k]);
-        estimated.apply(&dynamics.centre_of_mass(data, &q))
+        estimated.apply(&dynamics.centre_of_mass(data, &m.positions))
     }
 }
 
