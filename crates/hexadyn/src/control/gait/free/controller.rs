@@ -352,10 +352,10 @@ impl<L: LegMechanism> FreeGaitController<L> {
 
     /// The legs that lift now among the Rule 2-3 candidates, in order of increasing margin, those
     /// whose lift keeps the support balanced ([`Self::balanced`]). With a failed leg, if that
-    /// leaves the robot deadlocked
-    /// (Section 7.7.4: a support leg at its boundary, `boundary`, that does not lift), the leg of
-    /// lowest margin among those that Rule 2 alone allows and that keep the stability margin
-    /// lifts instead.
+    /// leaves the robot deadlocked (Section 7.7.4: a support leg at its boundary, `boundary`,
+    /// that does not lift), or if every working foot is down and the stability refuses all of
+    /// Rule 3's candidates, the leg of lowest margin among those that Rule 2 alone allows and
+    /// that keep the stability margin lifts instead.
     ///
     /// INTERPRETATION (beyond the thesis): on five legs Rule 3's candidate can be a leg whose
     /// lift would tip the robot; at the start, with the feet at their workspace centres and equal
@@ -363,23 +363,35 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// good (legs 0, 1 and 2 failed). Lifting another leg that Rule 2 allows is the smallest
     /// change that lets the walk go on: Rule 3 orders the legs, the stability decides.
     ///
-    /// INTERPRETATION: the fallback lifts only a leg at its boundary (or the leg the body sways
-    /// for, [`Self::sway`]). A leg far from its boundary that just landed at its AEP gains nothing
-    /// by stepping again during a deadlock, since the body stands still, and holds its neighbours
-    /// back under Rule 2: with leg 0 failed, legs 3 and 4 stepped in place for good while legs
-    /// 1, 2 and 5 stood at their boundaries (measured). The deadlock also lasts while the body
-    /// sways for a blocked leg, until that leg lifts.
+    /// INTERPRETATION: during a deadlock the fallback lifts only a leg at its boundary (or the
+    /// leg the body sways for, [`Self::sway`]). A leg far from its boundary that just landed at
+    /// its AEP gains nothing by stepping again during a deadlock, since the body stands still,
+    /// and holds its neighbours back under Rule 2: with leg 0 failed, legs 3 and 4 stepped in
+    /// place for good while legs 1, 2 and 5 stood at their boundaries (measured). The deadlock
+    /// also lasts while the body sways for a blocked leg, until that leg lifts.
+    ///
+    /// INTERPRETATION: with every foot down and the body walking, a refused candidate would hold
+    /// every other leg down until it reached its boundary. At the start the feet stand at their
+    /// workspace centres with equal margins, and the tie-break makes the lone leg at the leading
+    /// end (leg 1 with leg 0 failed) Rule 3's only candidate; its lift is unstable (the middle
+    /// feet beside the body centre are the front edge of the support left), so no leg lifted for
+    /// 29.6 s while the body walked a whole stroke, and the walk then deadlocked with every foot
+    /// at its boundary (0.88 m of 1 m with a front leg failed walking forwards, measured
+    /// 2026-11-29). The next leg in Rule 3's order that may lift, lifts.
     fn lifting(&self, candidates: [bool; 6], support: &[bool; 6], margins: &[f64; 6], centre: &Vector3<f64>, boundary: f64) -> [bool; 6] {
         let lifting = self.stable_lifts(candidates, margins, support, centre);
         if self.options.failed_leg.is_none() {
             return lifting;
         }
         let swaying = self.sway.map(|(b, _)| b);
-        if !deadlocked(support, margins, &lifting, boundary) && swaying.is_none_or(|b| lifting[b] || !support[b]) {
+        let deadlock = deadlocked(support, margins, &lifting, boundary) || swaying.is_some_and(|b| support[b] && !lifting[b]);
+        let all_down = (0..6).all(|l| !self.working(l) || support[l]);
+        let refused = !deadlock && all_down && candidates.contains(&true) && !lifting.contains(&true);
+        if !deadlock && !refused {
             return lifting;
         }
-        let at_boundary: [bool; 6] = std::array::from_fn(|l| rule_2(l, support, &self.neighbours) && (margins[l] < boundary || swaying == Some(l)));
-        let fallback = self.stable_lifts(at_boundary, margins, support, centre);
+        let allowed: [bool; 6] = std::array::from_fn(|l| rule_2(l, support, &self.neighbours) && ((refused && margins[l].is_finite()) || margins[l] < boundary || swaying == Some(l)));
+        let fallback = self.stable_lifts(allowed, margins, support, centre);
         let first = (0..6).filter(|&l| fallback[l]).min_by(|&a, &b| margins[a].total_cmp(&margins[b]));
         std::array::from_fn(|l| Some(l) == first)
     }
@@ -399,7 +411,13 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// quadruped crawl gaits, the usual remedy on a hexapod with a failed leg), until the lift
     /// keeps the stability margin and the leg lifts (Rule 3, [`Self::lifting`]). The feet at
     /// their boundary do not move outwards: the component of the sway that would push one out is
-    /// removed, so they slide along the boundary or move inwards; if the sway would take another
+    /// removed, so they slide along the boundary or move inwards. The blocked foot is the
+    /// exception while its leg reaches [`REACH_ROOM`] beyond it: it lifts once the sway is done,
+    /// and held to its workspace it stopped the sway it waits for (with leg 4 failed, leg 2's
+    /// foot at the rear and outer side of its workspace, offset outwards by the five-leg
+    /// footholds, let the body sway 2 mm/s instead of 5, and the walks with a rear leg failed
+    /// deadlocked 13-15 s at a time, 0.83-0.86 m of 1 m; with it 5 s, 0.95 m, measured
+    /// 2026-11-29). If the sway would take another
     /// support foot out of its workspace, or leaves no motion, or fewer than three feet would
     /// stay down, the body halts as in the thesis.
     #[allow(clippy::too_many_arguments)]
@@ -426,7 +444,14 @@ impl<L: LegMechanism> FreeGaitController<L> {
             };
             Vector3::new(n.x, n.y, 0.0).normalize()
         };
-        let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary).collect();
+        // The blocked foot, which lifts when the sway is done, may go on outwards while it keeps
+        // the security margin inside its reach.
+        let room = |k: usize| {
+            let foot = self.walk.legs[k].foot;
+            let out = foot.xy() - self.workspaces[k].centre;
+            k == blocked && out.norm() > 0.0 && self.legs_kinematics[k].reaches_point(&(foot + Vector3::new(out.x, out.y, 0.0).normalize() * REACH_ROOM))
+        };
+        let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary && !room(k)).collect();
         for &k in &at_boundary {
             let n = outward(k);
             u -= n * u.dot(&n).min(0.0);
