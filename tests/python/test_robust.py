@@ -278,7 +278,7 @@ def test_health_sees_a_five_legged_walk_halted_for_good():
     # 200 s at 0.5 cm/s commanded; the body's net advance is about 0.15 m (the sway of the deadlock).
     assert s["commanded_path_length_m"] == pytest.approx(1.0, rel=1e-3) and s["net_displacement_m"] < 0.3
     assert any("m commanded path" in w for w in s["warnings"]), s["warnings"]
-    # The shipped walk (leg 5 failed) is healthy.
+    # The shipped walk (leg 3 failed) is healthy.
     assert hexadyn.simulate("free_gait_five_legs", progress=False).summary["warnings"] == []
 
 

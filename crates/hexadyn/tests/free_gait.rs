@@ -245,8 +245,8 @@ fn free_gait_walks_on_five_legs_leg_1_failed() {
 
 // NOT MET on the full dynamic model with a leg failed at the trailing end of the walk (4 or 5
 // forwards, 0 or 1 backwards; issue 37; all six walk forwards on the ideal plant,
-// `control::gait::free::tests`). Measured 2026-11-29 (2-core AMD EPYC container, the working
-// tree of a7912e7 with the start's refused candidate and the blocked foot's sway): 0.954,
+// `control::gait::free::tests`). Measured 2026-11-29 (2-core AMD EPYC container, 9164fad, the
+// start's refused candidate and the blocked foot's sway): 0.954,
 // 0.957, 0.559 and 0.954 m of 1 m, deadlocks up to 5.3 s (leg 0 backwards halts for good),
 // but the body rocks onto two feet for 0.5-1.1 s and tilts up to 10°. With navigation (the
 // true body pose) the same four cover 0.991-0.993 m with at most 0.15 s on two feet and 5.5° of
@@ -255,7 +255,15 @@ fn free_gait_walks_on_five_legs_leg_1_failed() {
 // drift to 5-10°, the real body level between tips) and the stability check's vertical is
 // that far off. Before (a7912e7): the leading-end cases (above and below) went 0.819-0.885 m (no
 // lift for the first 29.6 s: see `FreeGaitController::lifting`), the trailing ones 0.497-0.862
-// m with deadlocks of 13-15 s (see `FreeGaitController::sway`). Tried and worse before: one leg
+// m with deadlocks of 13-15 s (see `FreeGaitController::sway`). Tried on 9164fad, not kept: an
+// inclinometer's pitch and roll in the estimated pose (all 12 cases 0.919-1.002 m, no permanent
+// deadlock, but 0.7-2.6 s on two feet and the body 3.5 cm low), or only as the stability
+// check's vertical (the four 0.816-0.933 m, leg 4 forwards halts for good); the support feet
+// from the encoders instead of the anchors, and the centre of mass checked one step ahead too:
+// no change (the support loss starts before any drift, with the check at its 20 mm bound: the
+// first, leg 4 forwards at 76.4 s, lifted leg 2 with legs 0, 1, 5 left and the body then walked
+// towards their diagonal's far side, 25 mm behind and 31 mm left of its reference by then).
+// Tried and worse before: one leg
 // in the air at a time (the walks fell behind: 0.17-0.61 m), a 4 cm margin for a support of
 // three feet (still 0.6-0.9 s on two feet), no lift unless the step gains half a stroke (fewer
 // than 40 landings everywhere).
