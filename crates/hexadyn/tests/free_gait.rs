@@ -260,9 +260,10 @@ fn free_gait_walks_on_five_legs_leg_1_failed() {
 // deadlock, but 0.7-2.6 s on two feet and the body 3.5 cm low), or only as the stability
 // check's vertical (the four 0.816-0.933 m, leg 4 forwards halts for good); the support feet
 // from the encoders instead of the anchors, and the centre of mass checked one step ahead too:
-// no change (the support loss starts before any drift, with the check at its 20 mm bound: the
-// first, leg 4 forwards at 76.4 s, lifted leg 2 with legs 0, 1, 5 left and the body then walked
-// towards their diagonal's far side, 25 mm behind and 31 mm left of its reference by then).
+// no change (the first support loss, leg 4 forwards at 76.4 s, starts before any drift: leg 2
+// lifted with legs 0, 1, 5 left, the check finding 20.0 mm now and 32.8 mm one step ahead, the
+// body 25 mm behind and 31 mm left of its reference by then, and the body rolled onto the
+// diagonal of legs 0 and 5).
 // Tried and worse before: one leg
 // in the air at a time (the walks fell behind: 0.17-0.61 m), a 4 cm margin for a support of
 // three feet (still 0.6-0.9 s on two feet), no lift unless the step gains half a stroke (fewer
