@@ -259,11 +259,14 @@ fn free_gait_walks_on_five_legs_leg_1_failed() {
 // inclinometer's pitch and roll in the estimated pose (all 12 cases 0.919-1.002 m, no permanent
 // deadlock, but 0.7-2.6 s on two feet and the body 3.5 cm low), or only as the stability
 // check's vertical (the four 0.816-0.933 m, leg 4 forwards halts for good); the support feet
-// from the encoders instead of the anchors, and the centre of mass checked one step ahead too:
-// no change (the first support loss, leg 4 forwards at 76.4 s, starts before any drift: leg 2
-// lifted with legs 0, 1, 5 left, the check finding 20.0 mm now and 32.8 mm one step ahead, the
-// body 25 mm behind and 31 mm left of its reference by then, and the body rolled onto the
-// diagonal of legs 0 and 5).
+// from the encoders instead of the anchors, and the centre of mass checked one step ahead too
+// (the body's walk, and the lifted leg's mass at its AEP): no change or no better. The first
+// support loss, leg 4 forwards, is at 63.5 s before any drift (desired roll 0.0°, pitch 0.3°):
+// leg 2 had lifted at 62.3 s with legs 0, 3, 5 left, the check finding 22.6 mm now and 37.4 mm
+// one step ahead about the centre of mass, and with leg 1 landing the body rolled onto the
+// diagonal of legs 0 and 5. Its landings then drifted the controller's frame: desired roll
+// 4.4° and pitch 3.5° at 76.4 s, the real body level, which puts the projection of a foot
+// 0.41 m below the body 31 mm off.
 // Tried and worse before: one leg
 // in the air at a time (the walks fell behind: 0.17-0.61 m), a 4 cm margin for a support of
 // three feet (still 0.6-0.9 s on two feet), no lift unless the step gains half a stroke (fewer
