@@ -243,54 +243,36 @@ fn free_gait_walks_on_five_legs_leg_1_failed() {
     assert_five_legs_walk(1, false);
 }
 
-// NOT MET on the full dynamic model with a leg failed at the trailing end of the walk (4 or 5
-// forwards, 0 or 1 backwards; issue 37; all six walk forwards on the ideal plant,
-// `control::gait::free::tests`). Measured 2026-11-29 (2-core AMD EPYC container, 9164fad, the
-// start's refused candidate and the blocked foot's sway): 0.954,
-// 0.957, 0.559 and 0.954 m of 1 m, deadlocks up to 5.3 s (leg 0 backwards halts for good),
-// but the body rocks onto two feet for 0.5-1.1 s and tilts up to 10°. With navigation (the
-// true body pose) the same four cover 0.991-0.993 m with at most 0.15 s on two feet and 5.5° of
-// tilt: without it the controller places each landing's anchor from the desired pose, so every
-// tip of the body rotates its frame (the posture's roll and pitch as the controller knows them
-// drift to 5-10°, the real body level between tips) and the stability check's vertical is
-// that far off. Before (a7912e7): the leading-end cases (above and below) went 0.819-0.885 m (no
-// lift for the first 29.6 s: see `FreeGaitController::lifting`), the trailing ones 0.497-0.862
-// m with deadlocks of 13-15 s (see `FreeGaitController::sway`). Tried on 9164fad, not kept: an
-// inclinometer's pitch and roll in the estimated pose (all 12 cases 0.919-1.002 m, no permanent
-// deadlock, but 0.7-2.6 s on two feet and the body 3.5 cm low), or only as the stability
-// check's vertical (the four 0.816-0.933 m, leg 4 forwards halts for good); the support feet
-// from the encoders instead of the anchors, and the centre of mass checked one step ahead too
-// (the body's walk, and the lifted leg's mass at its AEP): no change or no better. The first
-// support loss, leg 4 forwards, is at 63.5 s before any drift (desired roll 0.0°, pitch 0.3°):
-// leg 2 had lifted at 62.3 s with legs 0, 3, 5 left, the check finding 22.6 mm now and 37.4 mm
-// one step ahead about the centre of mass, and with leg 1 landing the body rolled onto the
-// diagonal of legs 0 and 5. Its landings then drifted the controller's frame: desired roll
-// 4.4° and pitch 3.5° at 76.4 s, the real body level, which puts the projection of a foot
-// 0.41 m below the body 31 mm off.
-// Tried and worse before: one leg
-// in the air at a time (the walks fell behind: 0.17-0.61 m), a 4 cm margin for a support of
-// three feet (still 0.6-0.9 s on two feet), no lift unless the step gains half a stroke (fewer
-// than 40 landings everywhere).
+// A leg failed at the trailing end of the walk (4 or 5 forwards, 0 or 1 backwards; issue 37).
+// Measured 2026-11-29 (2-core AMD EPYC container, 200 s at 0.5 cm/s, net advance of 1 m):
+// before the landing feet's pushes entered the stability check (`FreeGaitController::
+// landing_pushes`; 429615d) these walks covered 0.954, 0.957, 0.559 and 0.954 m with the body
+// rocking onto two feet for 0.5-1.1 s, tilting up to 10°, and leg 0 backwards halting for
+// good; the first support loss came before any drift of the controller's frame, a landing foot
+// rolling the body over a diagonal of the three feet left, and the landings during the tips
+// then drifted the frame (desired roll 4.4° and pitch 3.5° at 76 s with leg 4 failed, the real
+// body level). Tried and not kept then: an inclinometer's pitch and roll in the estimated pose
+// (all 12 cases 0.919-1.002 m but 0.7-2.6 s on two feet), or as the stability check's vertical
+// only; the support feet from the encoders; the centre of mass one step ahead (the body's
+// walk, the lifted leg's mass at its AEP). Before that, at a7912e7: the leading-end cases
+// 0.819-0.885 m (no lift for the first 29.6 s: `FreeGaitController::lifting`), the trailing
+// ones 0.497-0.862 m with deadlocks of 13-15 s (`FreeGaitController::sway`).
 #[test]
-#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_4_failed() {
     assert_five_legs_walk(4, false);
 }
 
 #[test]
-#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_on_five_legs_leg_5_failed() {
     assert_five_legs_walk(5, false);
 }
 
 #[test]
-#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_backwards_on_five_legs_leg_0_failed() {
     assert_five_legs_walk(0, true);
 }
 
 #[test]
-#[ignore = "NOT MET: see the comment above"]
 fn free_gait_walks_backwards_on_five_legs_leg_1_failed() {
     assert_five_legs_walk(1, true);
 }

@@ -17,7 +17,7 @@ use super::five_legs::{bands, Band};
 use crate::control::settling_time;
 use super::landing::LandingDetector;
 use super::posture::{ground_plane, solve_posture};
-use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates};
+use super::rules::{deadlocked, neighbours, rule_2, stability_margin, swing_candidates, Push};
 use super::stability::energy_stability_margin;
 use super::velocity::corrected_velocities;
 use crate::control::gait::body_motion::{BodyMotion, Pose};
@@ -487,13 +487,45 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// Whether the feet `support` keep the robot balanced with its centre of mass at `centre`
     /// ([`Self::centre_of_mass`]): the normalized energy stability margin of their anchors at
     /// least [`FreeGaitOptions::energy_margin`] (any number of legs) and, with a failed leg, the
-    /// centre of mass inside their polygon by at least [`FreeGaitOptions::stability_margin`].
+    /// centre of mass inside their polygon by at least [`FreeGaitOptions::stability_margin`],
+    /// against the pushes of the feet in the air when they land ([`Self::landing_pushes`]).
     fn balanced(&self, support: &[bool; 6], centre: &Vector3<f64>) -> bool {
         let horizontal = || {
             let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
-            stability_margin(&centre.xy(), &feet) >= self.options.stability_margin
+            stability_margin(&centre.xy(), &feet, &self.landing_pushes(support)) >= self.options.stability_margin
         };
         self.energy_margin_of(support, centre) >= self.options.energy_margin && (self.options.failed_leg.is_none() || horizontal())
+    }
+
+    /// The pushes on the body of the working feet that are not in `support` and not lifting now
+    /// (takeoff, swing, landing), each at the landing detection's threshold
+    /// ([`LandingDetector::threshold_n`]) over the robot's weight, where the foot is now (the
+    /// landing's virtual anchor, else the foot reference in the desired pose). None without the
+    /// robot's masses ([`Self::with_masses`]).
+    ///
+    /// INTERPRETATION (beyond the thesis, issue 37): a landing foot presses on the ground until
+    /// its landing is detected; the support must bear that push without tipping. On five legs
+    /// the support of three feet left while two legs step can be tipped by much less than the
+    /// threshold: with leg 4 failed, leg 2 lifted with the centre of mass 22.6 mm inside the
+    /// diagonal of legs 0 and 5 (2 cm asked), leg 1, 0.46 m beyond that diagonal, landed, and
+    /// about 15 N there (a fraction of the 40 N at which the currents detect the ground) rolled
+    /// the body onto the diagonal: leg 3 lost its load, the body rolled 3.7° while leg 1 went on
+    /// lowering its foot at 3 cm/s, undetected (measured 2026-11-29). The feet in the air are
+    /// counted where they are, not where they will land: taking the landing feet alone left
+    /// 0.7-1.1 s on two feet in the walks with a rear leg failed (a swinging foot landed during
+    /// the next lift), counting every foot in the air none.
+    fn landing_pushes(&self, support: &[bool; 6]) -> Vec<Push> {
+        let (Some((_, dynamics)), Some(body)) = (self.masses.as_ref(), self.walk.body.as_ref()) else { return Vec::new() };
+        let share = self.landing.threshold_n() / (dynamics.model.total_mass() * dynamics.model.gravity.norm());
+        let desired = body.pose.htm();
+        (0..6)
+            .filter(|&k| self.working(k) && !support[k] && self.walk.legs[k].phase != FootPhase::Support)
+            .map(|k| {
+                let leg = &self.walk.legs[k];
+                let at = if leg.phase == FootPhase::Landing { leg.anchor } else { self.leg_frame(k, &desired).apply(&leg.foot) };
+                Push { at: at.xy(), share }
+            })
+            .collect()
     }
 
     /// The normalized energy stability margin ([`super::stability`]) of the anchors of the feet

@@ -18,6 +18,10 @@ use crate::description::Robot;
 pub trait LandingDetector: Send {
     fn ground_contact(&mut self, m: &Measurements) -> [bool; 6];
 
+    /// The ground force (N) at which a landing is detected: what a landing foot may press on
+    /// the ground with while its leg still lowers it.
+    fn threshold_n(&self) -> f64;
+
     /// The ground force on each foot (leg frame, N) estimated from the measurements at the
     /// last [`Self::ground_contact`], when the detector estimates it (the elevator reflex of
     /// the swing reads it, [`super::elevator`]).
@@ -64,6 +68,10 @@ pub const THESIS_FORCE_THRESHOLD: f64 = 10.0;
 impl LandingDetector for NormalForce {
     fn ground_contact(&mut self, m: &Measurements) -> [bool; 6] {
         m.foot_normal_forces.map_or([false; 6], |f| f.map(|f| f > self.threshold))
+    }
+
+    fn threshold_n(&self) -> f64 {
+        self.threshold
     }
 }
 
@@ -160,6 +168,10 @@ impl<L: GroundSensingLeg + Send> LandingDetector for MotorCurrent<L> {
             self.pushed[l] = !self.raised[l] && self.sliding[l] <= -settled && d.force >= self.detector.threshold;
         }
         std::array::from_fn(|l| self.detections[l].detected && self.sliding[l] >= settled)
+    }
+
+    fn threshold_n(&self) -> f64 {
+        self.detector.threshold
     }
 
     fn pushed_up(&self) -> [bool; 6] {

@@ -118,24 +118,40 @@ pub fn deadlocked(support: &[bool; 6], margin: &[f64; 6], lifting: &[bool; 6], b
     (0..6).any(|l| support[l] && !lifting[l] && margin[l] < boundary)
 }
 
-/// Static stability margin (m) of a horizontal point `c` over the support feet `feet` (their
-/// horizontal positions): the largest, over the triangles of three feet, of the smallest signed
-/// distance from `c` to the triangle's sides (positive inside). Negative when `c` is outside the
-/// support polygon; −∞ for fewer than three feet.
-pub fn stability_margin(c: &Vector2<f64>, feet: &[Vector2<f64>]) -> f64 {
+/// An upward push of the ground on the body through a foot that is not in support: a landing
+/// foot pressing on the ground before its landing is detected. `at`: the foot's horizontal
+/// position; `share`: the push over the robot's weight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Push {
+    pub at: Vector2<f64>,
+    pub share: f64,
+}
+
+/// Static stability margin (m) of the centre of mass' horizontal position `c` over the support
+/// feet `feet` (their horizontal positions), with the upward `pushes` of landing feet: the
+/// largest, over the triangles of three feet, of the smallest, over the triangle's sides, of
+/// the signed distance d_c from `c` to the side (positive inside) less share · d_p for each push
+/// at a distance d_p > 0 inside that side. Negative when the robot tips over a side; −∞ for
+/// fewer than three feet.
+///
+/// Moments about a side: the weight W restores with W d_c; a push F inside the side lifts the
+/// support's interior about it with F d_p (a push outside it presses the interior down, and
+/// cannot tip the robot over that side). The robot stays on the side's feet while
+/// W d_c ≥ F d_p, i.e. d_c − (F/W) d_p ≥ 0: the margin is that of an equivalent centre of mass.
+pub fn stability_margin(c: &Vector2<f64>, feet: &[Vector2<f64>], pushes: &[Push]) -> f64 {
     let mut best = f64::NEG_INFINITY;
     let n = feet.len();
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
-                best = best.max(triangle_margin(c, &[feet[i], feet[j], feet[k]]));
+                best = best.max(triangle_margin(c, &[feet[i], feet[j], feet[k]], pushes));
             }
         }
     }
     best
 }
 
-fn triangle_margin(c: &Vector2<f64>, t: &[Vector2<f64>; 3]) -> f64 {
+fn triangle_margin(c: &Vector2<f64>, t: &[Vector2<f64>; 3], pushes: &[Push]) -> f64 {
     let orientation = (t[1] - t[0]).perp(&(t[2] - t[0])).signum();
     if orientation == 0.0 {
         return f64::NEG_INFINITY;
@@ -144,7 +160,8 @@ fn triangle_margin(c: &Vector2<f64>, t: &[Vector2<f64>; 3]) -> f64 {
         .map(|e| {
             let (a, b) = (t[e], t[(e + 1) % 3]);
             let edge = b - a;
-            orientation * edge.perp(&(c - a)) / edge.norm()
+            let inside = |p: &Vector2<f64>| orientation * edge.perp(&(p - a)) / edge.norm();
+            inside(c) - pushes.iter().map(|p| p.share * inside(&p.at).max(0.0)).sum::<f64>()
         })
         .fold(f64::INFINITY, f64::min)
 }
@@ -230,8 +247,29 @@ mod tests {
     fn stability_margin_of_a_triangle() {
         let h = 3f64.sqrt() / 2.0;
         let feet = [Vector2::new(1.0, 0.0), Vector2::new(-0.5, h), Vector2::new(-0.5, -h)];
-        assert!((stability_margin(&Vector2::zeros(), &feet) - 0.5).abs() < 1e-12);
-        assert!((stability_margin(&Vector2::new(-0.7, 0.0), &feet) + 0.2).abs() < 1e-12);
-        assert_eq!(stability_margin(&Vector2::zeros(), &feet[..2]), f64::NEG_INFINITY);
+        assert!((stability_margin(&Vector2::zeros(), &feet, &[]) - 0.5).abs() < 1e-12);
+        assert!((stability_margin(&Vector2::new(-0.7, 0.0), &feet, &[]) + 0.2).abs() < 1e-12);
+        assert_eq!(stability_margin(&Vector2::zeros(), &feet[..2], &[]), f64::NEG_INFINITY);
+    }
+
+    /// A push tips the robot over a side exactly when its moment about the side exceeds the
+    /// weight's: a unit-weight robot with its centre of mass 0.5 inside the side x = −0.5 of a
+    /// triangle, pushed at 1.5 inside it (at the opposite vertex x = 1) by a third of its
+    /// weight, is at the limit (0.5 − 0.5 = 0); a push outside a side does not count against
+    /// that side.
+    #[test]
+    fn stability_margin_with_a_landing_foots_push() {
+        let h = 3f64.sqrt() / 2.0;
+        let feet = [Vector2::new(1.0, 0.0), Vector2::new(-0.5, h), Vector2::new(-0.5, -h)];
+        let third = Push { at: Vector2::new(1.0, 0.0), share: 1.0 / 3.0 };
+        assert!(stability_margin(&Vector2::zeros(), &feet, &[third]).abs() < 1e-12);
+        // A tenth of the weight: 0.5 − 0.15 on that side; the two other sides (0.5 from the
+        // centre, the push on them) keep 0.5.
+        let tenth = Push { share: 0.1, ..third };
+        assert!((stability_margin(&Vector2::zeros(), &feet, &[tenth]) - 0.35).abs() < 1e-12);
+        // Pushed from outside the side x = −0.5 (at x = −1): not against that side (0.5 stays),
+        // against the two others, which it is 1.0 inside: 0.5 − 0.2 · 1.0.
+        let behind = Push { at: Vector2::new(-1.0, 0.0), share: 0.2 };
+        assert!((stability_margin(&Vector2::zeros(), &feet, &[behind]) - 0.3).abs() < 1e-12);
     }
 }

@@ -216,7 +216,7 @@ fn five_legged_walk(failed: usize) -> (f64, f64, bool, f64) {
             .filter(|&l| l != failed && phases[l] == FootPhase::Support)
             .map(|l| body.compose(&s.legs[l].body_from_leg()).apply(&c.foot_references()[l]).xy())
             .collect();
-        worst_margin = worst_margin.min(super::rules::stability_margin(&body.translation.xy(), &down));
+        worst_margin = worst_margin.min(super::rules::stability_margin(&body.translation.xy(), &down, &[]));
         true
     });
     let walked = c.desired_pose().unwrap().position.x;
