@@ -507,8 +507,8 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// its landing is detected; the support must bear that push without tipping. On five legs
     /// the support of three feet left while two legs step can be tipped by much less than the
     /// threshold: with leg 4 failed, leg 2 lifted with the centre of mass 22.6 mm inside the
-    /// diagonal of legs 0 and 5 (2 cm asked), leg 1, 0.46 m beyond that diagonal, landed, and
-    /// about 15 N there (a fraction of the 40 N at which the currents detect the ground) rolled
+    /// diagonal of legs 0 and 5 (2 cm asked), leg 1 landed 0.46 m from it on the support's
+    /// side, and about 15 N there (a fraction of the 40 N at which the currents detect it) rolled
     /// the body onto the diagonal: leg 3 lost its load, the body rolled 3.7° while leg 1 went on
     /// lowering its foot at 3 cm/s, undetected (measured 2026-11-29). The feet in the air are
     /// counted where they are, not where they will land: taking the landing feet alone left
