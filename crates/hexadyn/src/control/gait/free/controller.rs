@@ -446,12 +446,12 @@ impl<L: LegMechanism> FreeGaitController<L> {
         };
         // The blocked foot, which lifts when the sway is done, may go on outwards while it keeps
         // the security margin inside its reach.
-        let room = |k: usize| {
-            let foot = self.walk.legs[k].foot;
-            let out = foot.xy() - self.workspaces[k].centre;
-            k == blocked && out.norm() > 0.0 && self.legs_kinematics[k].reaches_point(&(foot + Vector3::new(out.x, out.y, 0.0).normalize() * REACH_ROOM))
+        let room = || {
+            let foot = self.walk.legs[blocked].foot;
+            let out = foot.xy() - self.workspaces[blocked].centre;
+            out.norm() > 0.0 && self.legs_kinematics[blocked].reaches_point(&(foot + Vector3::new(out.x, out.y, 0.0).normalize() * REACH_ROOM))
         };
-        let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary && !room(k)).collect();
+        let at_boundary: Vec<usize> = (0..6).filter(|&k| standing[k] && margins[k] < boundary && !(k == blocked && room())).collect();
         for &k in &at_boundary {
             let n = outward(k);
             u -= n * u.dot(&n).min(0.0);
@@ -492,13 +492,13 @@ impl<L: LegMechanism> FreeGaitController<L> {
     fn balanced(&self, support: &[bool; 6], centre: &Vector3<f64>) -> bool {
         let horizontal = || {
             let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
-            stability_margin(&centre.xy(), &feet, &self.landing_pushes(support)) >= self.options.stability_margin
+            stability_margin(&centre.xy(), &feet, &self.landing_pushes()) >= self.options.stability_margin
         };
         self.energy_margin_of(support, centre) >= self.options.energy_margin && (self.options.failed_leg.is_none() || horizontal())
     }
 
-    /// The pushes on the body of the working feet that are not in `support` and not lifting now
-    /// (takeoff, swing, landing), each at the landing detection's threshold
+    /// The pushes on the body of the working feet in the air (takeoff, swing, landing; not the
+    /// legs about to lift, still in support), each at the landing detection's threshold
     /// ([`LandingDetector::threshold_n`]) over the robot's weight, where the foot is now (the
     /// landing's virtual anchor, else the foot reference in the desired pose). None without the
     /// robot's masses ([`Self::with_masses`]).
@@ -514,12 +514,12 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// counted where they are, not where they will land: taking the landing feet alone left
     /// 0.7-1.1 s on two feet in the walks with a rear leg failed (a swinging foot landed during
     /// the next lift), counting every foot in the air none.
-    fn landing_pushes(&self, support: &[bool; 6]) -> Vec<Push> {
+    fn landing_pushes(&self) -> Vec<Push> {
         let (Some((_, dynamics)), Some(body)) = (self.masses.as_ref(), self.walk.body.as_ref()) else { return Vec::new() };
         let share = self.landing.threshold_n() / (dynamics.model.total_mass() * dynamics.model.gravity.norm());
         let desired = body.pose.htm();
         (0..6)
-            .filter(|&k| self.working(k) && !support[k] && self.walk.legs[k].phase != FootPhase::Support)
+            .filter(|&k| self.working(k) && self.walk.legs[k].phase != FootPhase::Support)
             .map(|k| {
                 let leg = &self.walk.legs[k];
                 let at = if leg.phase == FootPhase::Landing { leg.anchor } else { self.leg_frame(k, &desired).apply(&leg.foot) };
