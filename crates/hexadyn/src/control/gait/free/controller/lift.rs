@@ -10,6 +10,12 @@ use nalgebra::{Vector2, Vector3};
 use super::super::rules::{deadlocked, rule_2, stability_margin, Push};
 use super::super::stability::energy_stability_margin;
 use super::{FreeGaitController, REACH_ROOM};
+#[cfg(doc)]
+use super::super::landing::LandingDetector;
+#[cfg(doc)]
+use super::FreeGaitOptions;
+#[cfg(doc)]
+use crate::hexapod::LegDynamics;
 use crate::control::gait::pattern::FootPhase;
 use crate::control::Measurements;
 use crate::hexapod::Leg as LegMechanism;
@@ -134,14 +140,15 @@ impl<L: LegMechanism> FreeGaitController<L> {
 
     /// Among `candidates`, in order of increasing margin, the legs whose lift keeps the feet
     /// still in support balanced ([`Self::balanced`]).
-    pub(super) fn stable_lifts(&self, candidates: [bool; 6], margins: &[f64; 6], support: &[bool; 6], centre: &Vector3<f64>) -> [bool; 6] {
+    fn stable_lifts(&self, candidates: [bool; 6], margins: &[f64; 6], support: &[bool; 6], centre: &Vector3<f64>) -> [bool; 6] {
         let mut order: Vec<usize> = (0..6).filter(|&l| candidates[l]).collect();
         order.sort_by(|&a, &b| margins[a].total_cmp(&margins[b]));
+        let pushes = self.landing_pushes();
         let mut support = *support;
         let mut lifting = [false; 6];
         for l in order {
             support[l] = false;
-            if self.balanced(&support, centre) {
+            if self.balanced(&support, centre, &pushes) {
                 lifting[l] = true;
             } else {
                 support[l] = true;
@@ -153,14 +160,14 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// Whether the feet `support` keep the robot balanced with its centre of mass at `centre`
     /// ([`Self::centre_of_mass`]): the normalized energy stability margin of their anchors at
     /// least [`FreeGaitOptions::energy_margin`] (any number of legs) and the centre of mass
-    /// inside their polygon against the pushes of the feet in the air when they land
+    /// inside their polygon against `pushes`, those of the feet in the air when they land
     /// ([`Self::landing_pushes`]): by [`FreeGaitOptions::stability_margin`] with a failed leg, at
     /// all on six legs.
-    pub(super) fn balanced(&self, support: &[bool; 6], centre: &Vector3<f64>) -> bool {
+    fn balanced(&self, support: &[bool; 6], centre: &Vector3<f64>, pushes: &[Push]) -> bool {
         let horizontal = || {
             let feet: Vec<Vector2<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor.xy()).collect();
             let bound = if self.options.failed_leg.is_some() { self.options.stability_margin } else { 0.0 };
-            stability_margin(&centre.xy(), &feet, &self.landing_pushes()) >= bound
+            stability_margin(&centre.xy(), &feet, pushes) >= bound
         };
         self.energy_margin_of(support, centre) >= self.options.energy_margin && horizontal()
     }
@@ -187,7 +194,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
     /// 2026-11-29) the tripods on 20-25° slopes at the 4.5 cm lift and the staircases down at
     /// the thesis' lift tipped onto a lifting foot after a landing less often with it (slopes
     /// 65-85 % to 100 %, staircases down 4-8 cm 50-80 % to 60-85 %; docs/benchmarks.md).
-    pub(super) fn landing_pushes(&self) -> Vec<Push> {
+    fn landing_pushes(&self) -> Vec<Push> {
         let (Some((_, dynamics)), Some(body)) = (self.masses.as_ref(), self.walk.body.as_ref()) else { return Vec::new() };
         let share = self.landing.threshold_n() / (dynamics.model.total_mass() * dynamics.model.gravity.norm());
         let desired = body.pose.htm();
@@ -201,7 +208,7 @@ impl<L: LegMechanism> FreeGaitController<L> {
             .collect()
     }
 
-    /// The normalized energy stability margin ([`super::stability`]) of the anchors of the feet
+    /// The normalized energy stability margin ([`super::super::stability`]) of the anchors of the feet
     /// `support`, the centre of mass at `centre`.
     pub(super) fn energy_margin_of(&self, support: &[bool; 6], centre: &Vector3<f64>) -> f64 {
         let feet: Vec<Vector3<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor).collect();

@@ -72,8 +72,8 @@ pub struct FreeGaitOptions {
     /// A failed leg, held up (beyond the thesis: the rules extend to five legs).
     pub failed_leg: Option<usize>,
     /// Smallest static stability margin (m) that the feet left in support must keep when a leg
-    /// lifts against the pushes of the feet in the air ([`FreeGaitController::landing_pushes`]),
-    /// with a failed leg; on six legs the bound is zero (no tip-over).
+    /// lifts against the pushes of the feet in the air (each at the landing threshold where it
+    /// is), with a failed leg; on six legs the bound is zero (no tip-over).
     pub stability_margin: f64,
     /// Smallest normalized energy stability margin (m, [`super::stability`]) that the feet left
     /// in support must keep when a leg lifts, on six legs and on five (beyond the thesis: its
