@@ -22,7 +22,7 @@ catch what a reader of the figures would catch:
   limit switches cutting a motor (``limit_switch_cuts``); in the free gait, what it should never
   hold for long, each with when it began: a deadlock (``longest_deadlock_s``, or one still on at
   the end), fewer than three loaded feet (``longest_support_loss_s``), a foot in takeoff or
-  swing carrying load (``longest_airborne_load_s``);
+  swing carrying load (``longest_airborne_load_s``, one foot's, ``longest_airborne_load_leg``);
 - a foot beyond the border of a terrain mesh (``foot_left_terrain_t_s``), where there is no
   ground;
 - any non-finite figure.
@@ -154,6 +154,9 @@ def _walk_episodes(summary: Mapping[str, Any]) -> list[str]:
     warnings: list[str] = []
     for key, bound, what in _FREE_GAIT_EPISODES if summary["gait_pattern"] == "free" else ():
         duration, start = summary.get(f"longest_{key}_s"), summary.get(f"longest_{key}_t_s")
+        leg = summary.get(f"longest_{key}_leg")
+        if isinstance(leg, int) and not isinstance(leg, bool):
+            what = f"{what} (leg {leg})"
         if _finite(duration) and _finite(start) and duration > bound:
             warnings.append(f"{what} for {duration:.2f} s from t = {start:.2f} s (allowed {bound:g} s)")
     if summary.get("deadlocked_at_end") is True and not any(w.startswith("the free gait was deadlocked") for w in warnings):

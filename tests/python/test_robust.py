@@ -250,6 +250,7 @@ def test_health_checks_flag_meaningless_runs():
         ({"longest_deadlock_s": 3.0, "longest_deadlock_t_s": 197.0, "deadlocked_at_end": True}, "still deadlocked at the end (its longest deadlock began at t = 197.00 s)"),
         ({"longest_support_loss_s": 0.5, "longest_support_loss_t_s": 12.0}, "fewer than three feet carried the robot for 0.50 s from t = 12.00 s"),
         ({"longest_airborne_load_s": 2.0, "longest_airborne_load_t_s": 3.5}, "a foot in takeoff or swing carried load for 2.00 s from t = 3.50 s"),
+        ({"longest_airborne_load_s": 0.4, "longest_airborne_load_t_s": 56.1, "longest_airborne_load_leg": 3}, "a foot in takeoff or swing carried load (leg 3) for 0.40 s from t = 56.10 s"),
         ({"clamped_ik_references": 1712, "last_clamped_ik_reference_t_s": 339.17}, "1712 foot references were beyond the leg's reach and clamped into the joint ranges, the last at t = 339.17 s"),
         ({"limit_switch_cuts": 546}, "the limit switches cut a motor 546 times"),
     ]:

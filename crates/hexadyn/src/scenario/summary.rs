@@ -181,7 +181,12 @@ impl Summary {
             };
             episode("deadlock", &g.episodes.deadlock);
             episode("support_loss", &g.episodes.support_loss);
-            episode("airborne_load", &g.episodes.airborne_load);
+            let airborne = g.episodes.longest_airborne_load();
+            v.push((Cow::Borrowed("longest_airborne_load_s"), Number(airborne.map_or(0.0, |(d, _, _)| d))));
+            if let Some((_, t, leg)) = airborne {
+                v.push((Cow::Borrowed("longest_airborne_load_t_s"), Number(t)));
+                v.push((Cow::Borrowed("longest_airborne_load_leg"), Count(leg as u64)));
+            }
             v.push((Cow::Borrowed("deadlocked_at_end"), Flag(g.episodes.deadlock.ongoing())));
             if let Some(t) = g.last_clamped_t_s {
                 v.push((Cow::Borrowed("last_clamped_ik_reference_t_s"), Number(t)));
