@@ -11,8 +11,9 @@
 //! over 30°), no permanent deadlock (20 s to the end), never fewer than three loaded feet for
 //! more than 0.2 s, no foot in takeoff or swing carrying more than 15 % of the weight (50 N) for
 //! more than 0.3 s (one foot's stretch, the summary's `longest_airborne_load_s`), and a net
-//! advance of at least 90 % of the commanded path. Targets: at least 95 % up to 8 cm steps, 20° slopes and 2 cm RMS
-//! (issue 11); issue 37's classes up to 8 cm at the thesis' lift and up to 6 cm at a 4.5 cm lift.
+//! advance of at least 90 % of the commanded path. Targets: at least 95 % up to 8 cm steps, 20°
+//! slopes and 2 cm RMS (issue 11); issue 37's classes up to 8 cm at the thesis' lift and up to
+//! 6 cm at a 4.5 cm lift.
 //!
 //! Each run is the shipped `free_gait_straight.toml` (1 cm/s straight ahead, 4.5 cm lift,
 //! takeoff 1 s, swing 3 s, t_post 2 s, friction 0.7, landing detected from the motor currents

@@ -3,7 +3,7 @@
 
 use std::borrow::Cow;
 
-use super::episodes::{Episode, WalkEpisodes};
+use super::episodes::WalkEpisodes;
 use super::gait::GaitScenario;
 use super::Scenario;
 use crate::control::gait::controller::GaitDiagnostics;
@@ -173,18 +173,17 @@ impl Summary {
                 v.push((Cow::Borrowed("min_stability_margin_t_s"), Number(t)));
             }
             // The duration (0 when it never happened) and, when it did, its start.
-            let mut episode = |name: &'static str, e: &Episode| {
-                v.push((Cow::Owned(format!("longest_{name}_s")), Number(e.longest.map_or(0.0, |(d, _)| d))));
-                if let Some((_, t)) = e.longest {
+            let mut episode = |name: &'static str, longest: Option<(f64, f64)>| {
+                v.push((Cow::Owned(format!("longest_{name}_s")), Number(longest.map_or(0.0, |(d, _)| d))));
+                if let Some((_, t)) = longest {
                     v.push((Cow::Owned(format!("longest_{name}_t_s")), Number(t)));
                 }
             };
-            episode("deadlock", &g.episodes.deadlock);
-            episode("support_loss", &g.episodes.support_loss);
+            episode("deadlock", g.episodes.deadlock.longest);
+            episode("support_loss", g.episodes.support_loss.longest);
             let airborne = g.episodes.longest_airborne_load();
-            v.push((Cow::Borrowed("longest_airborne_load_s"), Number(airborne.map_or(0.0, |(d, _, _)| d))));
-            if let Some((_, t, leg)) = airborne {
-                v.push((Cow::Borrowed("longest_airborne_load_t_s"), Number(t)));
+            episode("airborne_load", airborne.map(|(d, t, _)| (d, t)));
+            if let Some((_, _, leg)) = airborne {
                 v.push((Cow::Borrowed("longest_airborne_load_leg"), Count(leg as u64)));
             }
             v.push((Cow::Borrowed("deadlocked_at_end"), Flag(g.episodes.deadlock.ongoing())));

@@ -208,13 +208,12 @@ impl<L: LegMechanism> FreeGaitController<L> {
             .collect()
     }
 
-    /// The normalized energy stability margin ([`super::super::stability`]) of the anchors of the feet
-    /// `support`, the centre of mass at `centre`.
+    /// The normalized energy stability margin ([`super::super::stability`]) of the anchors of
+    /// the feet `support`, the centre of mass at `centre`.
     pub(super) fn energy_margin_of(&self, support: &[bool; 6], centre: &Vector3<f64>) -> f64 {
         let feet: Vec<Vector3<f64>> = (0..6).filter(|&k| support[k]).map(|k| self.walk.legs[k].anchor).collect();
         energy_stability_margin(centre, &feet)
     }
-
 
     /// The centre of mass of the robot in the estimated body pose, the joints where the
     /// encoders put them ([`LegDynamics::centre_of_mass`]); the body frame's origin without
