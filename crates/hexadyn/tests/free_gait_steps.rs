@@ -7,7 +7,7 @@
 //! stops it; the elevator reflex (`control::gait::free::elevator`, from the motor currents)
 //! lifts it over. And down a staircase (issue 37), where a landing foot the ground pushes up
 //! has landed, and across a 20° slope, where a lift must not leave a support that a landing
-//! tips.
+//! tips, and down a staircase whose nosings the feet slide off.
 
 use std::path::Path;
 
@@ -93,4 +93,23 @@ fn a_20_degree_slope_is_walked_without_tipping_onto_a_lifting_foot() {
         assert!(lost.is_none_or(|(d, _)| d <= 0.2), "seed {seed}: fewer than three loaded feet: {lost:?}");
         assert!(airborne.is_none_or(|(d, _, _)| d <= 0.3), "seed {seed}: a foot in the air carried the body: {airborne:?}");
     }
+}
+
+/// Down three 4 cm risers (seed 9 of the class "stairs down 4 cm": treads 403 mm, edges at
+/// −23.2° to the heading) with the shipped 4.5 cm lift: feet that land on a tread's nosing slide
+/// off it down the riser when a neighbour lifts, and must land again rather than leave the
+/// lifting foot carrying the body (`SLIP_DROP`). Before (measured 2026-11-29 with the slip not
+/// seen), a support foot slid 32 mm down at 108.0 s and 39 mm at 138.8 s while legs 3 and 0
+/// lifted, and each of those feet, still on the ground in its takeoff, carried 67-95 N for
+/// 0.5-0.6 s as the body sank 11-15 mm.
+#[test]
+fn a_foot_sliding_off_a_nosing_lands_again_instead_of_a_lifting_foot_carrying_the_body() {
+    let (v, summary, drawn) = walk_onto(TerrainClass::Stairs { riser: 0.04, up: false }, 9, true);
+    let g = summary.gait.as_ref().expect("gait summary");
+    let (lost, airborne) = (g.episodes.support_loss.longest, g.episodes.longest_airborne_load());
+    println!("{drawn}: {v:?}; longest support loss {lost:?}, load in the air {airborne:?}");
+    assert!(drawn.starts_with("down 3 x 40 mm"), "{drawn}");
+    assert!(v.failure.is_none(), "{v:?}");
+    assert!(lost.is_none_or(|(d, _)| d <= 0.2), "fewer than three loaded feet: {lost:?}");
+    assert!(airborne.is_none_or(|(d, _, _)| d <= 0.3), "a foot in the air carried the body: {airborne:?}");
 }

@@ -54,6 +54,23 @@ pub const APPROACH_SPEED_M_S: f64 = 0.03;
 /// INTERPRETATION: the security margin of the working volume ([`AEP_SECURITY`]).
 pub const REACH_ROOM: f64 = AEP_SECURITY;
 
+/// How far (m) a support foot may go down from its anchor before it counts as sliding off its
+/// foothold.
+///
+/// INTERPRETATION (beyond the thesis, issue 37): a foot that lands on a tread's nosing, or on a
+/// ridge of rough ground, is detected there (Section 5.6.3) and slides off down the face when
+/// the load shifts onto it, typically as a neighbour lifts; the body sinks 1-3 cm with it and the
+/// lifting foot, still on the ground, carries it (every takeoff carrying load in the staircases
+/// and ramps of the terrain-class benchmark measured 2026-11-29 had a support foot 1.7-5.6 cm
+/// below its anchor). The encoders in the estimated body pose (the navigation system's) see it;
+/// the foot then lands again from where it is (down the face to the tread below, detected from
+/// the currents), and the takeoffs under way come back down, as the support they were checked
+/// against has changed. 1 cm: the security margin of the working volume ([`AEP_SECURITY`]), well
+/// above the millimetres a loaded foot sinks into the ground of Table 3.3. Without a navigation
+/// system the body pose is the desired one and the encoders follow their references: no slip is
+/// seen.
+pub const SLIP_DROP: f64 = AEP_SECURITY;
+
 /// Parameters of the free gait.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FreeGaitOptions {
@@ -263,6 +280,11 @@ impl<L: LegMechanism> FreeGaitController<L> {
         at((low - REACH_ROOM).max(floor))
     }
 
+    /// Where the encoders put the foot of `leg` (global) seen from the body pose `estimated`.
+    fn measured_foot(&self, leg: usize, m: &Measurements, estimated: &Htm) -> Vector3<f64> {
+        self.leg_frame(leg, estimated).apply(&self.legs_kinematics[leg].foot(&joints_of(m, leg)))
+    }
+
     fn working(&self, leg: usize) -> bool {
         self.options.failed_leg != Some(leg)
     }
@@ -444,10 +466,26 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                 _ => false,
             };
             if self.working(l) && landed {
-                let measured = self.leg_frame(l, &estimated).apply(&self.legs_kinematics[l].foot(&joints_of(m, l)));
+                let measured = self.measured_foot(l, m, &estimated);
                 let leg = &mut self.walk.legs[l];
                 (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured, measured, 0.0);
                 self.state.touchdowns[l] = true;
+            }
+        }
+        // Beyond the thesis (issue 37): a support foot that slides down off the edge it landed
+        // on lands again from where it is, and the takeoffs it was to carry turn back
+        // ([`SLIP_DROP`]).
+        let slipping: Vec<usize> = (0..6)
+            .filter(|&l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support)
+            .filter(|&l| self.walk.legs[l].anchor.z - self.measured_foot(l, m, &estimated).z > SLIP_DROP)
+            .collect();
+        if !slipping.is_empty() {
+            let takeoffs = (0..6).filter(|&l| self.walk.legs[l].phase == FootPhase::Takeoff);
+            for l in slipping.iter().copied().chain(takeoffs).collect::<Vec<_>>() {
+                let anchor = self.measured_foot(l, m, &estimated);
+                let leg = &mut self.walk.legs[l];
+                (leg.phase, leg.anchor, leg.elapsed, leg.descent) = (FootPhase::Landing, anchor, 0.0, 0.0);
+                self.landing.landing_starts(l);
             }
         }
         // Rule 1: the posture when a new leg touches the ground (and at the start).
