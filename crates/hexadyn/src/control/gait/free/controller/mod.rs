@@ -60,9 +60,9 @@ pub const REACH_ROOM: f64 = AEP_SECURITY;
 /// INTERPRETATION (beyond the thesis, issue 37): a foot that lands on a tread's nosing, or on a
 /// ridge of rough ground, is detected there (Section 5.6.3) and slides off down the face when
 /// the load shifts onto it, typically as a neighbour lifts; the body sinks 1-3 cm with it and the
-/// lifting foot, still on the ground, carries it (every takeoff carrying load in the staircases
-/// and ramps of the terrain-class benchmark measured 2026-11-29 had a support foot 1.7-5.6 cm
-/// below its anchor). The encoders in the estimated body pose (the navigation system's) see it;
+/// lifting foot, still on the ground, carries it (in the staircases and ramp drops of the
+/// terrain-class benchmark, 2026-11-29, all but one of the takeoffs that carried load without
+/// rising had a support foot 1.6-5.6 cm below its anchor). The encoders in the estimated body pose (the navigation system's) see it;
 /// the foot then lands again from where it is (down the face to the tread below, detected from
 /// the currents), and the takeoffs under way come back down, as the support they were checked
 /// against has changed. 1 cm: the security margin of the working volume ([`AEP_SECURITY`]), well
