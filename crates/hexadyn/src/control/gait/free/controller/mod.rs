@@ -62,13 +62,13 @@ pub const REACH_ROOM: f64 = AEP_SECURITY;
 /// the load shifts onto it, typically as a neighbour lifts; the body sinks 1-3 cm with it and the
 /// lifting foot, still on the ground, carries it (in the staircases and ramp drops of the
 /// terrain-class benchmark, 2026-11-29, all but one of the takeoffs that carried load without
-/// rising had a support foot 1.6-5.6 cm below its anchor). The encoders in the estimated body pose (the navigation system's) see it;
-/// the foot then lands again from where it is (down the face to the tread below, detected from
-/// the currents), and the takeoffs under way come back down, as the support they were checked
-/// against has changed. 1 cm: the security margin of the working volume ([`AEP_SECURITY`]), well
-/// above the millimetres a loaded foot sinks into the ground of Table 3.3. Without a navigation
-/// system the body pose is the desired one and the encoders follow their references: no slip is
-/// seen.
+/// rising had a support foot 1.6-5.6 cm below its anchor). The encoders in the estimated body
+/// pose (the navigation system's) see it; the foot then lands again from where it is (down the
+/// face to the tread below, detected from the currents), and the takeoffs under way come back
+/// down, as the support they were checked against has changed. 1 cm: the security margin of the
+/// working volume ([`AEP_SECURITY`]), well above the millimetres a loaded foot sinks into the
+/// ground of Table 3.3. Without a navigation system the body pose is the desired one and the
+/// encoders follow their references: no slip is seen.
 pub const SLIP_DROP: f64 = AEP_SECURITY;
 
 /// Parameters of the free gait.
@@ -458,6 +458,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         // against its swing is the elevator reflex's ([`super::elevator`]); a foot whose
         // reference rises (takeoff, the reflex's rise) is never pushed up.
         self.state.touchdowns = [false; 6];
+        let measured: [Vector3<f64>; 6] = std::array::from_fn(|l| self.measured_foot(l, m, &estimated));
         for l in 0..6 {
             let leg = &self.walk.legs[l];
             let landed = match leg.phase {
@@ -466,25 +467,20 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                 _ => false,
             };
             if self.working(l) && landed {
-                let measured = self.measured_foot(l, m, &estimated);
                 let leg = &mut self.walk.legs[l];
-                (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured, measured, 0.0);
+                (leg.phase, leg.anchor, leg.contact, leg.elapsed) = (FootPhase::Support, measured[l], measured[l], 0.0);
                 self.state.touchdowns[l] = true;
             }
         }
         // Beyond the thesis (issue 37): a support foot that slides down off the edge it landed
         // on lands again from where it is, and the takeoffs it was to carry turn back
         // ([`SLIP_DROP`]).
-        let slipping: Vec<usize> = (0..6)
-            .filter(|&l| self.working(l) && self.walk.legs[l].phase == FootPhase::Support)
-            .filter(|&l| self.walk.legs[l].anchor.z - self.measured_foot(l, m, &estimated).z > SLIP_DROP)
-            .collect();
-        if !slipping.is_empty() {
-            let takeoffs = (0..6).filter(|&l| self.walk.legs[l].phase == FootPhase::Takeoff);
-            for l in slipping.iter().copied().chain(takeoffs).collect::<Vec<_>>() {
-                let anchor = self.measured_foot(l, m, &estimated);
+        let slipping = |l: usize, leg: &Leg| self.working(l) && leg.phase == FootPhase::Support && leg.anchor.z - measured[l].z > SLIP_DROP;
+        if self.walk.legs.iter().enumerate().any(|(l, leg)| slipping(l, leg)) {
+            let again: [bool; 6] = std::array::from_fn(|l| slipping(l, &self.walk.legs[l]) || self.walk.legs[l].phase == FootPhase::Takeoff);
+            for l in (0..6).filter(|&l| again[l]) {
                 let leg = &mut self.walk.legs[l];
-                (leg.phase, leg.anchor, leg.elapsed, leg.descent) = (FootPhase::Landing, anchor, 0.0, 0.0);
+                (leg.phase, leg.anchor, leg.elapsed, leg.descent) = (FootPhase::Landing, measured[l], 0.0, 0.0);
                 self.landing.landing_starts(l);
             }
         }
