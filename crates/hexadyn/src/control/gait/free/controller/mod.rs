@@ -584,6 +584,13 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                             (leg.rise_to, leg.resisted) = (Some(back.z + o.lift), 0.0);
                             self.state.elevations += 1;
                             back
+                        } else if settled {
+                            // An obstacle above the leg's reach: back off and land in front of
+                            // it (super::elevator).
+                            (leg.phase, leg.elapsed, leg.descent, leg.resisted) = (FootPhase::Landing, 0.0, 0.0, 0.0);
+                            self.landing.landing_starts(l);
+                            leg.anchor = self.leg_frame(l, &estimated).apply(&back);
+                            back
                         } else {
                             if self.state.reaching_down {
                                 // Beyond the thesis (issue 37): the body goes down to a landing
