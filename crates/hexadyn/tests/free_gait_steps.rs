@@ -96,7 +96,7 @@ fn a_20_degree_slope_is_walked_without_tipping_onto_a_lifting_foot() {
 /// Down three 4 cm risers (seed 9 of the class "stairs down 4 cm": treads 403 mm, edges at
 /// −23.2° to the heading) with the shipped 4.5 cm lift: feet that land on a tread's nosing slide
 /// off it down the riser when a neighbour lifts, and must land again rather than leave the
-/// lifting foot carrying the body (`SLIP_DROP`). Before (measured 2026-11-29 with the slip not
+/// lifting foot carrying the body (`OFF_FOOTHOLD`). Before (measured 2026-11-29 with the slip not
 /// seen), a support foot slid 32 mm down at 108.0 s and 39 mm at 138.8 s while legs 3 and 0
 /// lifted, and each of those feet, still on the ground in its takeoff, carried 67-95 N for
 /// 0.5-0.6 s as the body sank 11-15 mm.
@@ -126,6 +126,25 @@ fn a_swinging_foot_against_a_boulder_above_its_reach_lands_in_front_of_it() {
     let (lost, airborne) = (g.episodes.support_loss.longest, g.episodes.longest_airborne_load());
     println!("{drawn}: {v:?}; longest support loss {lost:?}, load in the air {airborne:?}");
     assert!(drawn.contains("30.0 mm"), "{drawn}");
+    assert!(v.failure.is_none(), "{v:?}");
+    assert!(lost.is_none_or(|(d, _)| d <= 0.2), "fewer than three loaded feet: {lost:?}");
+    assert!(airborne.is_none_or(|(d, _, _)| d <= 0.3), "a foot in the air carried the body: {airborne:?}");
+}
+
+/// Up three 8 cm risers (seed 10 of the class "stairs up 8 cm": treads 462 mm) at the thesis'
+/// 10.5 cm lift: a support foot lifted off its foothold by the body tipping lands again
+/// (`OFF_FOOTHOLD`, up as well as down). Before (measured 2026-11-30 with only a foot gone down
+/// seen), a swinging rear foot met a riser at 139.6 s, the rear foot beside it slid 8 cm off a
+/// nosing, the body pitched from −7° to −13.7° and lifted the front right foot 4.4 cm off its
+/// tread, still in support for the controller; the middle foot beside it then lifted and, in
+/// its takeoff, carried 72-127 N for 0.4 s from 140.3 s.
+#[test]
+fn a_support_foot_lifted_off_its_foothold_lands_again() {
+    let (v, summary, drawn) = walk_onto(TerrainClass::Stairs { riser: 0.08, up: true }, 10, &[Override::new("gait.clearance_m", 0.105)]);
+    let g = summary.gait.as_ref().expect("gait summary");
+    let (lost, airborne) = (g.episodes.support_loss.longest, g.episodes.longest_airborne_load());
+    println!("{drawn}: {v:?}; longest support loss {lost:?}, load in the air {airborne:?}");
+    assert!(drawn.starts_with("up 3 x 80 mm"), "{drawn}");
     assert!(v.failure.is_none(), "{v:?}");
     assert!(lost.is_none_or(|(d, _)| d <= 0.2), "fewer than three loaded feet: {lost:?}");
     assert!(airborne.is_none_or(|(d, _, _)| d <= 0.3), "a foot in the air carried the body: {airborne:?}");

@@ -54,7 +54,7 @@ pub const APPROACH_SPEED_M_S: f64 = 0.03;
 /// INTERPRETATION: the security margin of the working volume ([`AEP_SECURITY`]).
 pub const REACH_ROOM: f64 = AEP_SECURITY;
 
-/// How far (m) a support foot may go down from its anchor before it counts as sliding off its
+/// How far (m) a support foot may go down or up from its anchor before it counts as off its
 /// foothold.
 ///
 /// INTERPRETATION (beyond the thesis, issue 37): a foot that lands on a tread's nosing, or on a
@@ -65,11 +65,14 @@ pub const REACH_ROOM: f64 = AEP_SECURITY;
 /// rising had a support foot 1.6-5.6 cm below its anchor). The encoders in the estimated body
 /// pose (the navigation system's) see it; the foot then lands again from where it is (down the
 /// face to the tread below, detected from the currents), and the takeoffs under way come back
-/// down, as the support they were checked against has changed. 1 cm: the security margin of the
-/// working volume ([`AEP_SECURITY`]), well above the millimetres a loaded foot sinks into the
-/// ground of Table 3.3. Without a navigation system the body pose is the desired one and the
-/// encoders follow their references: no slip is seen.
-pub const SLIP_DROP: f64 = AEP_SECURITY;
+/// down, as the support they were checked against has changed. The same holds for a support
+/// foot lifted off its foothold: when a foot slides off, the body tips onto it and raises the
+/// feet across (4-5 cm on a staircase up at the thesis' lift, 2026-11-30), which stay in support
+/// for the controller and let their neighbours lift; lowered again, they carry the body. 1 cm:
+/// the security margin of the working volume ([`AEP_SECURITY`]), well above the millimetres a
+/// loaded foot sinks into the ground of Table 3.3. Without a navigation system the body pose is
+/// the desired one and the encoders follow their references: nothing is seen.
+pub const OFF_FOOTHOLD: f64 = AEP_SECURITY;
 
 /// Parameters of the free gait.
 #[derive(Clone, Debug, PartialEq)]
@@ -473,9 +476,9 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             }
         }
         // Beyond the thesis (issue 37): a support foot that slides down off the edge it landed
-        // on lands again from where it is, and the takeoffs it was to carry turn back
-        // ([`SLIP_DROP`]).
-        let slipping = |l: usize, leg: &Leg| self.working(l) && leg.phase == FootPhase::Support && leg.anchor.z - measured[l].z > SLIP_DROP;
+        // on, or that the body lifts off it, lands again from where it is, and the takeoffs it
+        // was to carry turn back ([`OFF_FOOTHOLD`]).
+        let slipping = |l: usize, leg: &Leg| self.working(l) && leg.phase == FootPhase::Support && (leg.anchor.z - measured[l].z).abs() > OFF_FOOTHOLD;
         if self.walk.legs.iter().enumerate().any(|(l, leg)| slipping(l, leg)) {
             let again: [bool; 6] = std::array::from_fn(|l| slipping(l, &self.walk.legs[l]) || self.walk.legs[l].phase == FootPhase::Takeoff);
             for l in (0..6).filter(|&l| again[l]) {
