@@ -483,7 +483,7 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
             let again: [bool; 6] = std::array::from_fn(|l| slipping(l, &self.walk.legs[l]) || self.walk.legs[l].phase == FootPhase::Takeoff);
             for l in (0..6).filter(|&l| again[l]) {
                 let leg = &mut self.walk.legs[l];
-                (leg.phase, leg.anchor, leg.elapsed, leg.descent) = (FootPhase::Landing, measured[l], 0.0, 0.0);
+                leg.land_from(measured[l]);
                 self.landing.landing_starts(l);
             }
         }
@@ -590,9 +590,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                         } else if settled {
                             // An obstacle above the leg's reach: back off and land in front of
                             // it (super::elevator).
-                            (leg.phase, leg.elapsed, leg.descent, leg.resisted) = (FootPhase::Landing, 0.0, 0.0, 0.0);
+                            leg.land_from(self.leg_frame(l, &estimated).apply(&back));
                             self.landing.landing_starts(l);
-                            leg.anchor = self.leg_frame(l, &estimated).apply(&back);
                             back
                         } else {
                             if self.state.reaching_down {
@@ -609,9 +608,8 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
                             if leg.elapsed >= leg.swing_time - 0.5 * o.dt {
                                 // The landing: a virtual anchor where the foot is, so that the
                                 // support algorithm runs while the foot descends (Section 7.6).
-                                (leg.phase, leg.elapsed, leg.descent) = (FootPhase::Landing, 0.0, 0.0);
+                                leg.land_from(self.leg_frame(l, &estimated).apply(&p));
                                 self.landing.landing_starts(l);
-                                leg.anchor = self.leg_frame(l, &estimated).apply(&p);
                             }
                             p
                         }
@@ -696,6 +694,15 @@ impl<L: LegMechanism> Controller for FreeGaitController<L> {
         (self.state.pitch, self.state.roll) = (angles.y, angles.z);
 
         joint_command(&mut self.pis, self.feedforward.as_mut(), references, m)
+    }
+}
+
+impl Leg {
+    /// The landing begins from `anchor` (global), the virtual anchor of the descending foot
+    /// (Section 7.6): the end of the swing, a swing stopped by an obstacle it cannot rise over
+    /// ([`super::elevator`]), a support foot off its foothold ([`OFF_FOOTHOLD`]).
+    fn land_from(&mut self, anchor: Vector3<f64>) {
+        (self.phase, self.anchor, self.elapsed, self.descent) = (FootPhase::Landing, anchor, 0.0, 0.0);
     }
 }
 
